@@ -1,0 +1,67 @@
+//! Speed targets of the solver core, measured with criterion:
+//! `cargo bench --bench solver` (all), or e.g. `cargo bench --bench solver -- xor`.
+//!
+//! - `xor_640x480`: the XOR term alone (target <= 2 us).
+//! - `sample_mickey_stage2`: one Mickey sample on one core (flight, contacts, shadow,
+//!   every term of stage 2; target <= 50 us).
+//! - `sample_mickey_all_terms`: the same with all ten terms on.
+//! - `solve_mickey_2_threads`: the whole two-stage Mickey solve on 2 threads (target <= 5 s).
+
+use std::hint::black_box;
+use std::path::Path;
+use std::sync::atomic::AtomicUsize;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+
+use bsa::energy::Weights;
+use bsa::evaluate::Problem;
+use bsa::solver::{self, SolveOptions};
+
+fn mickey() -> Problem {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/mickey");
+    Problem::new(bsa::scene::load(&dir).expect("scenes/mickey loads"))
+}
+
+/// A launch close to a solution, so that the shadow and terms are realistic.
+const NEAR_SOLUTION: [f64; 18] = [
+    0.0, 1.5, 8.05, 0.0, 0.0, 0.0, //
+    1.46, -0.39, 8.56, 0.0, 0.0, 0.0, //
+    -1.46, -0.39, 8.56, 0.0, 0.0, 0.0,
+];
+
+fn benches(c: &mut Criterion) {
+    let p = mickey();
+    let mut ws = p.workspace();
+    let stage2 = p.scene.stages[1].weights;
+    p.evaluate(&NEAR_SOLUTION, &stage2, &mut ws);
+    let shadow = ws.mask.clone();
+    let target = p.target.mask.clone();
+
+    c.bench_function("xor_640x480", |b| {
+        b.iter(|| black_box(&shadow).xor_count(black_box(&target)))
+    });
+    c.bench_function("sample_mickey_stage2", |b| {
+        b.iter(|| black_box(p.evaluate(black_box(&NEAR_SOLUTION), &stage2, &mut ws)))
+    });
+    let all = Weights::all_ones();
+    c.bench_function("sample_mickey_all_terms", |b| {
+        b.iter(|| black_box(p.evaluate(black_box(&NEAR_SOLUTION), &all, &mut ws)))
+    });
+
+    let mut group = c.benchmark_group("solve");
+    group.sample_size(10);
+    group.bench_function("solve_mickey_2_threads", |b| {
+        b.iter(|| {
+            let none = AtomicUsize::new(0);
+            let opts = SolveOptions {
+                threads: Some(2),
+                ..SolveOptions::default()
+            };
+            black_box(solver::solve(&p, &opts, &mut solver::Silent, &none))
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(solver_benches, benches);
+criterion_main!(solver_benches);

@@ -1,0 +1,1696 @@
+//! Rigid bodies: shapes, exact mass properties and exact torque-free free flight.
+//!
+//! The main types and how data flows through them:
+//!
+//! * [`TriMesh`] is a triangle mesh in its own (body) coordinates. [`load_obj`] reads one
+//!   from a Wavefront OBJ file, welds vertices that share a position, checks it and turns
+//!   inward-facing meshes outward.
+//! * [`Shape`] is what a launched object is: a [`Shape::Sphere`] or [`Shape::Cuboid`]
+//!   centred on the body origin, or a shared [`Shape::Mesh`]. The body frame is the
+//!   shape's own coordinate frame.
+//! * [`Shape::mass_properties`] turns a shape and a density into [`MassProperties`]:
+//!   mass, centre of mass in the body frame, principal moments about the centre of mass
+//!   and the rotation from the principal axes into the body frame. Meshes are integrated
+//!   exactly (divergence theorem over signed tetrahedra) and diagonalised with
+//!   [`sym_eigen`], which stays accurate for tiny real objects.
+//! * [`FreeFlight::reset`] takes the mass properties and a launch state (pose, linear and
+//!   angular velocity, gravity) and prepares an exact torque-free flight; the pose at any
+//!   time is then a cheap query ([`FreeFlight::pose`], [`FreeFlight::orientation`],
+//!   [`FreeFlight::com`], ...).
+//!
+//! Flight is exact in the following sense. The centre of mass follows the parabola
+//! `x0 + v t + g t^2 / 2`. The rotation conserves the world angular momentum `L`:
+//!
+//! * isotropic inertia (sphere, cube): `R(t) = exp(w t) R0`, exact;
+//! * axisymmetric inertia (two equal principal moments `I_perp`, symmetry axis `a` in the
+//!   body frame, moment `I_a` about it): `R(t) = exp(t L / I_perp) R0 exp(t beta a)` with
+//!   `beta = (a . w_body(0)) (1 - I_a / I_perp)`, exact (the derivation is in `BODY.md`);
+//! * asymmetric inertia: `q' = q (0, w_p) / 2` with `w_p = I^-1 q^* L q` for the
+//!   principal-frame quaternion `q`, integrated by RK4 on a uniform grid over
+//!   `[0, t_max]` at reset; a query is one partial RK4 step from the grid state just
+//!   before `t`, so it costs the same at any time.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{DMat3, DQuat, DVec3};
+
+use crate::linalg::sym_eigen;
+
+/// Relative tolerance under which two principal moments count as equal, so that the
+/// closed-form isotropic or axisymmetric rotation is used. At 1e-9 the closed form's
+/// error from treating them as equal is about 1e-9 of the rotation angle, far below the
+/// RK4 error it replaces, and meshes with a discrete rotational symmetry of order three
+/// or more (a lathed pawn) come out equal to rounding (~1e-15).
+pub const EQUAL_MOMENT_RTOL: f64 = 1e-9;
+
+/// A triangle mesh in body coordinates. Triangles are counter-clockwise seen from
+/// outside for a correctly oriented closed mesh (so its signed volume is positive).
+/// Indices must be smaller than `vertices.len()`; the methods panic otherwise.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriMesh {
+    pub vertices: Vec<DVec3>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl TriMesh {
+    pub fn new(vertices: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Self {
+        Self {
+            vertices,
+            triangles,
+        }
+    }
+
+    /// Centre of the axis-aligned bounding box of the vertices (zero for an empty mesh).
+    /// Sums over triangles are taken relative to it so that a small object far from its
+    /// origin does not lose digits to cancellation.
+    fn reference_point(&self) -> DVec3 {
+        let (lo, hi) = self.bounding_box();
+        if self.vertices.is_empty() {
+            DVec3::ZERO
+        } else {
+            0.5 * (lo + hi)
+        }
+    }
+
+    /// Axis-aligned bounding box `(min, max)` of the vertices; inverted (`+inf`, `-inf`)
+    /// for an empty mesh.
+    pub fn bounding_box(&self) -> (DVec3, DVec3) {
+        self.vertices.iter().fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), &v| (lo.min(v), hi.max(v)),
+        )
+    }
+
+    /// Signed enclosed volume (divergence theorem). Positive for a closed mesh whose
+    /// normals point outward; for an open mesh the value depends on the hole and is only
+    /// meaningful as a sign check.
+    pub fn signed_volume(&self) -> f64 {
+        let r = self.reference_point();
+        let six_v: f64 = self
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = self.corners(t, r);
+                a.dot(b.cross(c))
+            })
+            .sum();
+        six_v / 6.0
+    }
+
+    /// True if every directed edge occurs exactly once and its reverse exactly once, i.e.
+    /// the mesh is a closed, consistently oriented 2-manifold-with-pinches surface.
+    /// Triangles that repeat a vertex index or refer to a missing vertex make it false.
+    pub fn is_closed_and_oriented(&self) -> bool {
+        if self.triangles.is_empty() {
+            return false;
+        }
+        let n = self.vertices.len() as u64;
+        let mut edges: Vec<u64> = Vec::with_capacity(3 * self.triangles.len());
+        for t in &self.triangles {
+            for i in 0..3 {
+                let (a, b) = (t[i] as u64, t[(i + 1) % 3] as u64);
+                if a == b || a >= n || b >= n {
+                    return false;
+                }
+                edges.push((a << 32) | b);
+            }
+        }
+        edges.sort_unstable();
+        if edges.windows(2).any(|w| w[0] == w[1]) {
+            return false;
+        }
+        edges
+            .iter()
+            .all(|&e| edges.binary_search(&e.rotate_right(32)).is_ok())
+    }
+
+    /// Reverses the orientation of every triangle (normals point the other way).
+    pub fn flip(&mut self) {
+        for t in &mut self.triangles {
+            t.swap(1, 2);
+        }
+    }
+
+    /// Total area of the triangles.
+    pub fn surface_area(&self) -> f64 {
+        let r = self.reference_point();
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = self.corners(t, r);
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum()
+    }
+
+    #[inline]
+    fn corners(&self, t: &[u32; 3], r: DVec3) -> [DVec3; 3] {
+        [
+            self.vertices[t[0] as usize] - r,
+            self.vertices[t[1] as usize] - r,
+            self.vertices[t[2] as usize] - r,
+        ]
+    }
+}
+
+/// Why [`load_obj`] rejected a file.
+#[derive(Debug, thiserror::Error)]
+pub enum ObjError {
+    /// The file could not be opened or read, or tobj could not parse it.
+    #[error("cannot read or parse OBJ file {path}: {source}")]
+    Load {
+        path: PathBuf,
+        #[source]
+        source: tobj::LoadError,
+    },
+    /// The file parsed but holds no triangle with three distinct vertices (no `f` lines,
+    /// or only points, lines and collapsed faces).
+    #[error("OBJ file {path} has no faces")]
+    NoFaces { path: PathBuf },
+    /// A vertex coordinate is NaN or infinite after scaling.
+    #[error("OBJ file {path}: vertex {index} is not finite after scaling by {scale}: {vertex}")]
+    NonFiniteVertex {
+        path: PathBuf,
+        index: usize,
+        vertex: DVec3,
+        scale: f64,
+    },
+    /// The faces enclose (almost) no volume: |V| <= 1e-9 of the cube of the largest
+    /// bounding-box side (a flat or zero-thickness mesh, or a zero scale), so it has no
+    /// usable mass properties.
+    #[error("OBJ file {path} encloses no volume: {volume} for a bounding box of side {extent}")]
+    DegenerateVolume {
+        path: PathBuf,
+        volume: f64,
+        extent: f64,
+    },
+}
+
+/// Loads every model of an OBJ file into one [`TriMesh`], multiplying coordinates by
+/// `scale` (e.g. 0.001 for a file in millimetres).
+///
+/// Faces are triangulated as fans. Vertices with bit-identical positions are welded
+/// (tobj's `single_index` duplicates a position for every distinct normal or texture
+/// coordinate, and separate models or groups never share indices), and triangles that
+/// collapse to a repeated vertex are dropped, so a watertight file gives a closed mesh.
+/// If the mesh then has negative signed volume it is flipped so that its normals point
+/// outward; this is exact for a closed, consistently oriented mesh (the common case of
+/// an inside-out export) and, for an open mesh, at least keeps its mass positive. Open
+/// meshes are accepted: check [`TriMesh::is_closed_and_oriented`] if that matters, as
+/// their volume and mass properties are then only approximate.
+pub fn load_obj(path: &Path, scale: f64) -> Result<TriMesh, ObjError> {
+    // The struct update keeps this compiling if another crate enables tobj's optional
+    // `merging` or `reordering` features, which add fields to `LoadOptions`.
+    #[allow(clippy::needless_update)]
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    let (models, _materials) = tobj::load_obj(path, &options).map_err(|source| ObjError::Load {
+        path: path.to_path_buf(),
+        source,
+    })?;
+
+    // Weld: key every loaded position by its f32 bit pattern (with -0 folded into +0),
+    // sort, and give equal keys one vertex index.
+    let mut keyed: Vec<([u32; 3], u32)> = Vec::new();
+    let mut raw_triangles: Vec<[u32; 3]> = Vec::new();
+    for model in &models {
+        let mesh = &model.mesh;
+        let base = keyed.len() as u32;
+        for p in mesh.positions.chunks_exact(3) {
+            let key = [p[0], p[1], p[2]].map(|x| (x + 0.0).to_bits());
+            keyed.push((key, keyed.len() as u32));
+        }
+        for t in mesh.indices.chunks_exact(3) {
+            raw_triangles.push([base + t[0], base + t[1], base + t[2]]);
+        }
+    }
+    keyed.sort_unstable();
+    let mut remap = vec![0u32; keyed.len()];
+    let mut vertices: Vec<DVec3> = Vec::new();
+    for (i, (key, original)) in keyed.iter().enumerate() {
+        if i == 0 || keyed[i - 1].0 != *key {
+            let [x, y, z] = key.map(|b| f32::from_bits(b) as f64 * scale);
+            vertices.push(DVec3::new(x, y, z));
+        }
+        remap[*original as usize] = vertices.len() as u32 - 1;
+    }
+    let triangles: Vec<[u32; 3]> = raw_triangles
+        .iter()
+        .map(|t| t.map(|i| remap[i as usize]))
+        .filter(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0])
+        .collect();
+    if triangles.is_empty() {
+        return Err(ObjError::NoFaces {
+            path: path.to_path_buf(),
+        });
+    }
+    if let Some((index, &vertex)) = vertices.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(ObjError::NonFiniteVertex {
+            path: path.to_path_buf(),
+            index,
+            vertex,
+            scale,
+        });
+    }
+    // Unreferenced vertices are harmless for mass properties but would inflate the
+    // bounding radius and support points, so keep only the used ones.
+    let mut mesh = compact(vertices, triangles);
+    let (lo, hi) = mesh.bounding_box();
+    let extent = (hi - lo).max_element();
+    let volume = mesh.signed_volume();
+    if !volume.is_finite() || volume.abs() <= 1e-9 * extent * extent * extent {
+        return Err(ObjError::DegenerateVolume {
+            path: path.to_path_buf(),
+            volume,
+            extent,
+        });
+    }
+    if volume < 0.0 {
+        mesh.flip();
+    }
+    Ok(mesh)
+}
+
+/// Drops vertices that no triangle uses and renumbers the triangles.
+fn compact(vertices: Vec<DVec3>, mut triangles: Vec<[u32; 3]>) -> TriMesh {
+    let mut new_index = vec![u32::MAX; vertices.len()];
+    let mut kept = Vec::with_capacity(vertices.len());
+    for t in &mut triangles {
+        for i in t.iter_mut() {
+            let slot = &mut new_index[*i as usize];
+            if *slot == u32::MAX {
+                *slot = kept.len() as u32;
+                kept.push(vertices[*i as usize]);
+            }
+            *i = *slot;
+        }
+    }
+    TriMesh::new(kept, triangles)
+}
+
+/// The solid of a body, in body coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    /// A ball centred on the body origin.
+    Sphere { radius: f64 },
+    /// A box centred on the body origin with faces normal to the body axes.
+    Cuboid { half_extents: DVec3 },
+    /// A closed, outward-oriented triangle mesh (see [`load_obj`]).
+    Mesh(Arc<TriMesh>),
+}
+
+/// Mass, centre of mass and inertia of a rigid body.
+///
+/// `principal_inertia[i]` is the moment of inertia about the centre of mass around the
+/// principal axis `principal_frame * e_i` (a body-frame direction). `principal_frame` is a
+/// proper rotation from principal coordinates into the body frame, so the body-frame
+/// inertia tensor is `P diag(principal_inertia) P^T`. Meshes list the moments in
+/// ascending order; the primitives list them along the body axes x, y, z.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MassProperties {
+    pub mass: f64,
+    pub local_com: DVec3,
+    pub principal_inertia: DVec3,
+    pub principal_frame: DQuat,
+}
+
+impl MassProperties {
+    /// Inertia tensor about the centre of mass, in body axes.
+    pub fn inertia_tensor(&self) -> DMat3 {
+        let p = DMat3::from_quat(self.principal_frame);
+        p * DMat3::from_diagonal(self.principal_inertia) * p.transpose()
+    }
+}
+
+impl Shape {
+    /// Enclosed volume. For a mesh this is the absolute signed volume, matching
+    /// [`Shape::mass_properties`], which treats an inside-out mesh as if it were flipped.
+    pub fn volume(&self) -> f64 {
+        match self {
+            Shape::Sphere { radius } => 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3),
+            Shape::Cuboid { half_extents: h } => 8.0 * h.x * h.y * h.z,
+            Shape::Mesh(mesh) => mesh.signed_volume().abs(),
+        }
+    }
+
+    /// Mass properties of the solid at uniform `density` (kg/m^3 for metres).
+    pub fn mass_properties(&self, density: f64) -> MassProperties {
+        match self {
+            Shape::Sphere { radius } => {
+                let mass = density * self.volume();
+                MassProperties {
+                    mass,
+                    local_com: DVec3::ZERO,
+                    principal_inertia: DVec3::splat(0.4 * mass * radius * radius),
+                    principal_frame: DQuat::IDENTITY,
+                }
+            }
+            Shape::Cuboid { half_extents: h } => {
+                let mass = density * self.volume();
+                let s = *h * *h;
+                MassProperties {
+                    mass,
+                    local_com: DVec3::ZERO,
+                    principal_inertia: mass / 3.0 * DVec3::new(s.y + s.z, s.z + s.x, s.x + s.y),
+                    principal_frame: DQuat::IDENTITY,
+                }
+            }
+            Shape::Mesh(mesh) => mesh_mass_properties(mesh, density),
+        }
+    }
+
+    /// Largest distance from `about` (body frame) to a point of the solid.
+    pub fn bounding_radius(&self, about: DVec3) -> f64 {
+        match self {
+            Shape::Sphere { radius } => about.length() + radius,
+            // The farthest corner is the one on the opposite side in every axis.
+            Shape::Cuboid { half_extents } => (about.abs() + *half_extents).length(),
+            Shape::Mesh(mesh) => mesh
+                .vertices
+                .iter()
+                .map(|v| v.distance_squared(about))
+                .fold(0.0, f64::max)
+                .sqrt(),
+        }
+    }
+
+    /// A point of the solid farthest along `dir` (body frame). For a zero `dir` any point
+    /// of the surface is a valid answer; the sphere then returns `(radius, 0, 0)`. Meshes
+    /// scan all vertices (O(n)).
+    pub fn support(&self, dir: DVec3) -> DVec3 {
+        match self {
+            Shape::Sphere { radius } => dir.normalize_or(DVec3::X) * *radius,
+            Shape::Cuboid { half_extents } => {
+                DVec3::select(dir.cmplt(DVec3::ZERO), -*half_extents, *half_extents)
+            }
+            Shape::Mesh(mesh) => {
+                mesh.vertices
+                    .iter()
+                    .copied()
+                    .fold((f64::NEG_INFINITY, DVec3::ZERO), |(best, p), v| {
+                        let d = v.dot(dir);
+                        if d > best {
+                            (d, v)
+                        } else {
+                            (best, p)
+                        }
+                    })
+                    .1
+            }
+        }
+    }
+}
+
+/// Exact mass properties of the solid bounded by a closed mesh.
+///
+/// Each triangle `(a, b, c)` spans a signed tetrahedron with the reference point; with
+/// `d = a . (b x c)` its volume is `d / 6`, its first moment `d (a + b + c) / 24` and its
+/// second moment `integral x x^T dV = d / 120 (a a^T + b b^T + c c^T + s s^T)`,
+/// `s = a + b + c`. Summing gives the exact polyhedral integrals. All tolerances are
+/// relative, so a 3 cm pawn and a 3 m statue are treated alike.
+fn mesh_mass_properties(mesh: &TriMesh, density: f64) -> MassProperties {
+    let r = mesh.reference_point();
+    let mut six_v = 0.0;
+    let mut first = DVec3::ZERO;
+    // Second moments: xx, yy, zz, xy, yz, zx.
+    let mut m2 = [0.0f64; 6];
+    for t in &mesh.triangles {
+        let [a, b, c] = mesh.corners(t, r);
+        let d = a.dot(b.cross(c));
+        let s = a + b + c;
+        six_v += d;
+        first += d * s;
+        let sq = a * a + b * b + c * c + s * s;
+        m2[0] += d * sq.x;
+        m2[1] += d * sq.y;
+        m2[2] += d * sq.z;
+        m2[3] += d * (a.x * a.y + b.x * b.y + c.x * c.y + s.x * s.y);
+        m2[4] += d * (a.y * a.z + b.y * b.z + c.y * c.z + s.y * s.z);
+        m2[5] += d * (a.z * a.x + b.z * b.x + c.z * c.x + s.z * s.x);
+    }
+    let volume = six_v / 6.0;
+    // An inside-out mesh gives all integrals with the opposite sign; treating it as
+    // flipped keeps the mass positive.
+    let sign = volume.signum();
+    let c = first / (4.0 * six_v);
+    let cov = |k: usize, x: f64, y: f64| sign * (m2[k] / 120.0 - volume * x * y);
+    let (cxx, cyy, czz) = (cov(0, c.x, c.x), cov(1, c.y, c.y), cov(2, c.z, c.z));
+    let (cxy, cyz, czx) = (cov(3, c.x, c.y), cov(4, c.y, c.z), cov(5, c.z, c.x));
+    // Inertia = density * (trace(C) 1 - C), C the covariance about the centre of mass.
+    let inertia = [
+        cyy + czz,
+        -cxy,
+        -czx,
+        -cxy,
+        czz + cxx,
+        -cyz,
+        -czx,
+        -cyz,
+        cxx + cyy,
+    ]
+    .map(|x| density * x);
+    let (mut values, mut vectors, mut work) = ([0.0; 3], [0.0; 9], [0.0; 9]);
+    sym_eigen(3, &inertia, &mut values, &mut vectors, &mut work);
+    let col = |k: usize| DVec3::new(vectors[k], vectors[3 + k], vectors[6 + k]);
+    let (e0, e1) = (col(0), col(1));
+    // The eigenvector matrix may be a reflection; the third axis is then reversed so
+    // that the frame is a proper rotation (any sign of an eigenvector is valid).
+    let e2 = if e0.cross(e1).dot(col(2)) < 0.0 {
+        -col(2)
+    } else {
+        col(2)
+    };
+    MassProperties {
+        mass: density * volume.abs(),
+        local_com: r + c,
+        principal_inertia: DVec3::from_array(values),
+        principal_frame: DQuat::from_mat3(&DMat3::from_cols(e0, e1, e2)).normalize(),
+    }
+}
+
+/// Exact maximum of `|w(t)|` over a torque-free motion with three distinct moments,
+/// with a small rounding margin.
+///
+/// The body-frame momentum `L_b` keeps `sum x_i = |L|^2` and `sum x_i / I_i = 2E` with
+/// `x_i = L_i^2 >= 0`, while `|w|^2 = sum x_i / I_i^2` is linear in `x`. The two
+/// constraints cut a segment out of the octant, the polhode sweeps all of it (each
+/// `L_i` that changes sign passes through zero), so the maximum is at an end of the
+/// segment, where one `x_k` is zero. This is tighter than `|L| / I_min` by up to the
+/// ratio of the moments and lets the RK4 step be as long as the motion allows.
+fn asymmetric_max_speed(inertia: DVec3, l_principal: DVec3) -> f64 {
+    let x = l_principal * l_principal;
+    let inv = inertia.recip();
+    let (l2, two_e) = (x.element_sum(), x.dot(inv));
+    let mut best = x.dot(inv * inv);
+    for k in 0..3 {
+        // Solve x_i + x_j = l2, x_i / I_i + x_j / I_j = 2E with x_k = 0.
+        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+        let det = inv[j] - inv[i];
+        if det == 0.0 {
+            continue;
+        }
+        let xj = (two_e - l2 * inv[i]) / det;
+        let xi = l2 - xj;
+        if xi >= 0.0 && xj >= 0.0 {
+            best = best.max(xi * inv[i] * inv[i] + xj * inv[j] * inv[j]);
+        }
+    }
+    // Cancellation in the 2 x 2 solve can lose a few digits when two moments are close;
+    // 1e-9 covers it while keeping the bound tight.
+    best.sqrt() * (1.0 + 1e-9)
+}
+
+/// Step-size control for the RK4 integration of asymmetric bodies.
+///
+/// The step is `min(rk4_max_step, rk4_max_angle / w_max)` with `w_max` the bound of
+/// [`FreeFlight::max_angular_speed`], shrunk so that a whole number of steps spans
+/// `[0, t_max]`. RK4's global orientation error scales with `rk4_max_angle^4`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlightConfig {
+    /// Longest step in seconds (default 0.01 s, only binding for slow spins).
+    pub rk4_max_step: f64,
+    /// Largest rotation per step in radians (default 0.02 rad: for a tumbling brick at
+    /// ~20 rad/s, measured orientation error 7e-7 rad and relative energy drift 1.1e-9
+    /// after 2 s; both scale as the fourth power of this value, the cost inversely; see
+    /// `BODY.md` for the table).
+    pub rk4_max_angle: f64,
+}
+
+impl Default for FlightConfig {
+    fn default() -> Self {
+        Self {
+            rk4_max_step: 0.01,
+            rk4_max_angle: 0.02,
+        }
+    }
+}
+
+/// Which rotation law [`FreeFlight`] uses, chosen from the principal moments at reset
+/// with the relative tolerance [`EQUAL_MOMENT_RTOL`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RotationKind {
+    /// All three moments equal: constant angular velocity (closed form).
+    Isotropic,
+    /// Two moments equal: regular precession (closed form).
+    Axisymmetric,
+    /// Three distinct moments: RK4 on a precomputed grid.
+    Asymmetric,
+}
+
+/// Exact torque-free flight of one rigid body launched at `t = 0` (see the module docs).
+///
+/// Create once with [`Default`] and [`reset`](FreeFlight::reset) for every launch: the
+/// RK4 grid buffer is reused, so resets allocate only when `t_max` grows past what an
+/// earlier reset needed.
+#[derive(Clone, Debug)]
+pub struct FreeFlight {
+    /// Centre of mass at launch (world).
+    com0: DVec3,
+    v0: DVec3,
+    g: DVec3,
+    local_com: DVec3,
+    /// Body-to-world rotation at launch.
+    q0: DQuat,
+    /// Principal-to-body rotation.
+    principal_frame: DQuat,
+    inv_inertia: DVec3,
+    /// Half of `inv_inertia`, as the quaternion rate uses it.
+    half_inv_inertia: DVec3,
+    /// World angular momentum, constant during flight.
+    l_world: DVec3,
+    kind: RotationKind,
+    /// World angular velocity of the closed forms' left factor: `w0` (isotropic) or
+    /// `L / I_perp` (axisymmetric).
+    precession: DVec3,
+    /// Body-frame angular velocity of the right factor, `beta a` (axisymmetric only).
+    spin_body: DVec3,
+    w_max: f64,
+    t_max: f64,
+    /// Grid step and its inverse (asymmetric only).
+    h: f64,
+    inv_h: f64,
+    /// Principal-to-world quaternions at `k h`, `k = 0..=n` (asymmetric only).
+    states: Vec<DQuat>,
+}
+
+impl Default for FreeFlight {
+    /// A body at rest at the origin, unit isotropic inertia, no gravity.
+    fn default() -> Self {
+        Self {
+            com0: DVec3::ZERO,
+            v0: DVec3::ZERO,
+            g: DVec3::ZERO,
+            local_com: DVec3::ZERO,
+            q0: DQuat::IDENTITY,
+            principal_frame: DQuat::IDENTITY,
+            inv_inertia: DVec3::ONE,
+            half_inv_inertia: DVec3::splat(0.5),
+            l_world: DVec3::ZERO,
+            kind: RotationKind::Isotropic,
+            precession: DVec3::ZERO,
+            spin_body: DVec3::ZERO,
+            w_max: 0.0,
+            t_max: 0.0,
+            h: 0.0,
+            inv_h: 0.0,
+            states: Vec::new(),
+        }
+    }
+}
+
+/// Time derivative of the principal-to-world quaternion: `q' = q (0, w_p) / 2` with the
+/// principal-frame angular velocity `w_p = I^-1 (q^* L q)`. Both products are polynomial
+/// in `q`, so the field is smooth off the unit sphere and RK4 keeps its fourth order even
+/// though the stage values are not normalised.
+#[inline(always)]
+fn quat_rate(q: DQuat, l_world: DVec3, half_inv_inertia: DVec3) -> DQuat {
+    // Written out in scalars: the RK4 stages form one long dependency chain, and this
+    // form has a shorter critical path than composing glam's generic products.
+    let (x, y, z, w) = (q.x, q.y, q.z, q.w);
+    let (lx, ly, lz) = (l_world.x, l_world.y, l_world.z);
+    // v = q^* L q = (w^2 - b^2) L + 2 (b . L) b - 2 w (b x L), with b = (x, y, z).
+    let s = w * w - (x * x + y * y + z * z);
+    let d = 2.0 * (x * lx + y * ly + z * lz);
+    let w2 = 2.0 * w;
+    let vx = s * lx + d * x - w2 * (y * lz - z * ly);
+    let vy = s * ly + d * y - w2 * (z * lx - x * lz);
+    let vz = s * lz + d * z - w2 * (x * ly - y * lx);
+    // Half the principal angular velocity, then q (0, w_p / 2).
+    let (ax, ay, az) = (
+        vx * half_inv_inertia.x,
+        vy * half_inv_inertia.y,
+        vz * half_inv_inertia.z,
+    );
+    DQuat::from_xyzw(
+        w * ax + y * az - z * ay,
+        w * ay + z * ax - x * az,
+        w * az + x * ay - y * ax,
+        -(x * ax + y * ay + z * az),
+    )
+}
+
+/// Pulls a nearly unit quaternion back to unit length with one Newton step for
+/// `1 / sqrt(|q|^2)`: RK4 changes the norm by far less than 1e-9 per step, so the
+/// residual (~ the square of that) is below rounding, and the step avoids the square
+/// root and division that would lengthen the serial chain of the integration.
+#[inline(always)]
+fn renormalize(q: DQuat) -> DQuat {
+    q * (1.5 - 0.5 * q.length_squared())
+}
+
+/// One classical RK4 step of length `h` for [`quat_rate`] (result not normalised).
+#[inline(always)]
+fn rk4_step(q: DQuat, h: f64, l_world: DVec3, half_inv_inertia: DVec3) -> DQuat {
+    let k1 = quat_rate(q, l_world, half_inv_inertia);
+    let k2 = quat_rate(q + k1 * (0.5 * h), l_world, half_inv_inertia);
+    let k3 = quat_rate(q + k2 * (0.5 * h), l_world, half_inv_inertia);
+    let k4 = quat_rate(q + k3 * h, l_world, half_inv_inertia);
+    q + (k1 + (k2 + k3) * 2.0 + k4) * (h / 6.0)
+}
+
+impl FreeFlight {
+    /// Prepares the flight of a body with mass properties `mp` launched at `t = 0`.
+    ///
+    /// `origin`, `orientation`: pose of the body frame at launch (world); `v`: centre-of-
+    /// mass velocity (m/s, world); `w`: angular velocity (rad/s, world); `g`: gravity
+    /// (m/s^2). `t_max` is the latest time that will be queried: the asymmetric case
+    /// integrates up to it now, so that every later query is O(1). Queries outside
+    /// `[0, t_max]` stay correct but integrate from the nearest end of the grid at query
+    /// time (cost proportional to the distance). Allocates only if the grid needs more
+    /// states than any earlier reset.
+    ///
+    /// Panics if a principal moment is not positive and finite.
+    #[allow(clippy::too_many_arguments)]
+    pub fn reset(
+        &mut self,
+        mp: &MassProperties,
+        origin: DVec3,
+        orientation: DQuat,
+        v: DVec3,
+        w: DVec3,
+        g: DVec3,
+        t_max: f64,
+        cfg: &FlightConfig,
+    ) {
+        let inertia = mp.principal_inertia;
+        assert!(
+            inertia.is_finite() && inertia.min_element() > 0.0,
+            "principal moments must be positive and finite: {inertia}"
+        );
+        let q0 = orientation.normalize();
+        let p = mp.principal_frame.normalize();
+        let qp0 = q0 * p;
+        let w_principal = qp0.conjugate() * w;
+        let l_principal = inertia * w_principal;
+        let l_world = qp0 * l_principal;
+
+        self.com0 = origin + q0 * mp.local_com;
+        self.v0 = v;
+        self.g = g;
+        self.local_com = mp.local_com;
+        self.q0 = q0;
+        self.principal_frame = p;
+        self.inv_inertia = inertia.recip();
+        self.half_inv_inertia = 0.5 * self.inv_inertia;
+        self.l_world = l_world;
+        self.t_max = t_max;
+        self.precession = DVec3::ZERO;
+        self.spin_body = DVec3::ZERO;
+        self.states.clear();
+
+        let [i0, i1, i2] = inertia.to_array();
+        let tol = EQUAL_MOMENT_RTOL * inertia.max_element();
+        // The closed forms keep |w| constant, so |w0| itself bounds it; the margin
+        // covers rounding in the queries.
+        let closed_form_bound = w.length() * (1.0 + 1e-12);
+        if inertia.max_element() - inertia.min_element() <= tol {
+            self.kind = RotationKind::Isotropic;
+            self.precession = w;
+            self.w_max = closed_form_bound;
+            return;
+        }
+        let symmetric_axis = if (i0 - i1).abs() <= tol {
+            Some(2)
+        } else if (i1 - i2).abs() <= tol {
+            Some(0)
+        } else if (i2 - i0).abs() <= tol {
+            Some(1)
+        } else {
+            None
+        };
+        if let Some(k) = symmetric_axis {
+            // Regular precession. With n(t) the world symmetry axis, w = L / I_perp +
+            // beta n solves Euler's equations: it makes I(t) w = L, and n rotates about L
+            // so that n . L = I_a w_a stays constant. See BODY.md for the derivation.
+            let i_perp = 0.5 * (inertia.element_sum() - inertia[k]);
+            let beta = w_principal[k] * (1.0 - inertia[k] / i_perp);
+            let mut e = DVec3::ZERO;
+            e[k] = 1.0;
+            self.kind = RotationKind::Axisymmetric;
+            self.precession = l_world / i_perp;
+            self.spin_body = p * e * beta;
+            self.w_max = closed_form_bound;
+            return;
+        }
+
+        self.kind = RotationKind::Asymmetric;
+        self.w_max = asymmetric_max_speed(inertia, l_principal);
+        let h_target = if self.w_max > 0.0 {
+            cfg.rk4_max_step.min(cfg.rk4_max_angle / self.w_max)
+        } else {
+            cfg.rk4_max_step
+        };
+        assert!(
+            h_target > 0.0 && h_target.is_finite(),
+            "invalid flight config {cfg:?}"
+        );
+        let n = if t_max > 0.0 && t_max.is_finite() {
+            (t_max / h_target).ceil().max(1.0) as usize
+        } else {
+            0
+        };
+        self.h = if n > 0 { t_max / n as f64 } else { h_target };
+        self.inv_h = 1.0 / self.h;
+        self.states.reserve(n + 1);
+        let mut q = qp0;
+        self.states.push(q);
+        for _ in 0..n {
+            q = renormalize(rk4_step(q, self.h, l_world, self.half_inv_inertia));
+            self.states.push(q);
+        }
+    }
+
+    /// Centre of mass at time `t` (world): `x0 + v t + g t^2 / 2`.
+    #[inline]
+    pub fn com(&self, t: f64) -> DVec3 {
+        self.com0 + self.v0 * t + self.g * (0.5 * t * t)
+    }
+
+    /// Centre-of-mass velocity at time `t` (world).
+    #[inline]
+    pub fn com_velocity(&self, t: f64) -> DVec3 {
+        self.v0 + self.g * t
+    }
+
+    /// Rotation from the body frame to the world at time `t`.
+    pub fn orientation(&self, t: f64) -> DQuat {
+        match self.kind {
+            RotationKind::Isotropic => {
+                (DQuat::from_scaled_axis(self.precession * t) * self.q0).normalize()
+            }
+            RotationKind::Axisymmetric => (DQuat::from_scaled_axis(self.precession * t)
+                * self.q0
+                * DQuat::from_scaled_axis(self.spin_body * t))
+            .normalize(),
+            RotationKind::Asymmetric => {
+                (self.principal_orientation(t) * self.principal_frame.conjugate()).normalize()
+            }
+        }
+    }
+
+    /// Body origin at time `t` (world): `com(t) - R(t) local_com`.
+    #[inline]
+    pub fn origin(&self, t: f64) -> DVec3 {
+        self.com(t) - self.orientation(t) * self.local_com
+    }
+
+    /// Body origin and orientation at time `t`, sharing one orientation evaluation.
+    #[inline]
+    pub fn pose(&self, t: f64) -> (DVec3, DQuat) {
+        let r = self.orientation(t);
+        (self.com(t) - r * self.local_com, r)
+    }
+
+    /// Angular velocity at time `t` (world), `R I^-1 R^T L`.
+    pub fn angular_velocity(&self, t: f64) -> DVec3 {
+        match self.kind {
+            RotationKind::Isotropic => self.precession,
+            RotationKind::Axisymmetric => self.precession + self.orientation(t) * self.spin_body,
+            RotationKind::Asymmetric => {
+                let q = self.principal_orientation(t).normalize();
+                q * (self.inv_inertia * (q.conjugate() * self.l_world))
+            }
+        }
+    }
+
+    /// An upper bound of `|w(t)|` over all `t`, for conservative advancement: `|w0|`
+    /// (with a 1e-12 rounding margin) in the closed-form cases, where it is constant, and
+    /// the exact maximum over the polhode (with a 1e-9 margin) for asymmetric bodies.
+    #[inline]
+    pub fn max_angular_speed(&self) -> f64 {
+        self.w_max
+    }
+
+    /// World angular momentum about the centre of mass (constant).
+    #[inline]
+    pub fn angular_momentum(&self) -> DVec3 {
+        self.l_world
+    }
+
+    /// The rotation law chosen at reset.
+    #[inline]
+    pub fn rotation_kind(&self) -> RotationKind {
+        self.kind
+    }
+
+    /// Number of RK4 steps taken at reset (0 for the closed forms).
+    #[inline]
+    pub fn rk4_steps(&self) -> usize {
+        self.states.len().saturating_sub(1)
+    }
+
+    /// The `t_max` given at reset.
+    #[inline]
+    pub fn t_max(&self) -> f64 {
+        self.t_max
+    }
+
+    /// Principal-to-world rotation at time `t` (asymmetric case), not normalised.
+    fn principal_orientation(&self, t: f64) -> DQuat {
+        let n = self.states.len() - 1;
+        let s = t * self.inv_h;
+        if (0.0..=n as f64).contains(&s) {
+            // Within the grid: one partial step from the state at or just before t.
+            let k = (s as usize).min(n);
+            let tau = t - k as f64 * self.h;
+            return rk4_step(self.states[k], tau, self.l_world, self.half_inv_inertia);
+        }
+        // Outside the grid: march from the nearer end with full steps, then one partial
+        // step. A NaN t falls through to a NaN quaternion without looping.
+        let (mut q, mut remaining, h) = if t > 0.0 {
+            (self.states[n], t - n as f64 * self.h, self.h)
+        } else {
+            (self.states[0], t, -self.h)
+        };
+        while remaining.abs() > self.h {
+            q = renormalize(rk4_step(q, h, self.l_world, self.half_inv_inertia));
+            remaining -= h;
+        }
+        rk4_step(q, remaining, self.l_world, self.half_inv_inertia)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::HashMap;
+    use std::f64::consts::PI;
+
+    fn rel(a: f64, b: f64) -> f64 {
+        (a - b).abs() / b.abs()
+    }
+
+    /// Rotation angle between two orientations (sign-insensitive). Taken from the vector
+    /// part of the relative rotation, because `2 acos(|a . b|)` cannot resolve angles
+    /// below ~3e-8 rad in f64.
+    fn angle_between(a: DQuat, b: DQuat) -> f64 {
+        let d = a.normalize().conjugate() * b.normalize();
+        2.0 * d.xyz().length().atan2(d.w.abs())
+    }
+
+    fn box_mesh(lo: DVec3, hi: DVec3) -> TriMesh {
+        let v = (0..8)
+            .map(|i| {
+                DVec3::new(
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
+                )
+            })
+            .collect();
+        // Outward counter-clockwise faces of the cube with corner bits (x, y, z).
+        let quads = [
+            [0, 2, 3, 1], // z = lo
+            [4, 5, 7, 6], // z = hi
+            [0, 1, 5, 4], // y = lo
+            [2, 6, 7, 3], // y = hi
+            [0, 4, 6, 2], // x = lo
+            [1, 3, 7, 5], // x = hi
+        ];
+        let t = quads
+            .iter()
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect();
+        TriMesh::new(v, t)
+    }
+
+    fn transformed(mesh: &TriMesh, rot: DQuat, shift: DVec3) -> TriMesh {
+        TriMesh::new(
+            mesh.vertices.iter().map(|&v| rot * v + shift).collect(),
+            mesh.triangles.clone(),
+        )
+    }
+
+    fn icosphere(radius: f64, levels: usize) -> TriMesh {
+        let p = (1.0 + 5f64.sqrt()) / 2.0;
+        let mut v: Vec<DVec3> = [
+            [-1.0, p, 0.0],
+            [1.0, p, 0.0],
+            [-1.0, -p, 0.0],
+            [1.0, -p, 0.0],
+            [0.0, -1.0, p],
+            [0.0, 1.0, p],
+            [0.0, -1.0, -p],
+            [0.0, 1.0, -p],
+            [p, 0.0, -1.0],
+            [p, 0.0, 1.0],
+            [-p, 0.0, -1.0],
+            [-p, 0.0, 1.0],
+        ]
+        .iter()
+        .map(|a| DVec3::from_array(*a).normalize())
+        .collect();
+        let mut t: Vec<[u32; 3]> = vec![
+            [0, 11, 5],
+            [0, 5, 1],
+            [0, 1, 7],
+            [0, 7, 10],
+            [0, 10, 11],
+            [1, 5, 9],
+            [5, 11, 4],
+            [11, 10, 2],
+            [10, 7, 6],
+            [7, 1, 8],
+            [3, 9, 4],
+            [3, 4, 2],
+            [3, 2, 6],
+            [3, 6, 8],
+            [3, 8, 9],
+            [4, 9, 5],
+            [2, 4, 11],
+            [6, 2, 10],
+            [8, 6, 7],
+            [9, 8, 1],
+        ];
+        for _ in 0..levels {
+            let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
+            let mut next = Vec::with_capacity(t.len() * 4);
+            for tri in &t {
+                let mut m = [0u32; 3];
+                for i in 0..3 {
+                    let (a, b) = (tri[i], tri[(i + 1) % 3]);
+                    m[i] = *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                        v.push((v[a as usize] + v[b as usize]).normalize());
+                        v.len() as u32 - 1
+                    });
+                }
+                next.push([tri[0], m[0], m[2]]);
+                next.push([tri[1], m[1], m[0]]);
+                next.push([tri[2], m[2], m[1]]);
+                next.push([m[0], m[1], m[2]]);
+            }
+            t = next;
+        }
+        TriMesh::new(v.into_iter().map(|x| x * radius).collect(), t)
+    }
+
+    /// Surface of revolution about +z through the profile points `(r, z)`, whose first and
+    /// last points lie on the axis, with `segments` sectors.
+    fn lathe(profile: &[(f64, f64)], segments: u32) -> TriMesh {
+        let rings = profile.len() as u32 - 2;
+        let mut v = vec![DVec3::new(0.0, 0.0, profile[0].1)];
+        for &(r, z) in &profile[1..profile.len() - 1] {
+            for j in 0..segments {
+                let a = 2.0 * PI * j as f64 / segments as f64;
+                v.push(DVec3::new(r * a.cos(), r * a.sin(), z));
+            }
+        }
+        let top = v.len() as u32;
+        v.push(DVec3::new(0.0, 0.0, profile[profile.len() - 1].1));
+        let at = |ring: u32, j: u32| 1 + ring * segments + j % segments;
+        let mut t = Vec::new();
+        for j in 0..segments {
+            t.push([0, at(0, j + 1), at(0, j)]);
+            for ring in 0..rings - 1 {
+                let (a, b) = (at(ring, j), at(ring, j + 1));
+                let (c, d) = (at(ring + 1, j + 1), at(ring + 1, j));
+                t.push([a, b, c]);
+                t.push([a, c, d]);
+            }
+            t.push([top, at(rings - 1, j), at(rings - 1, j + 1)]);
+        }
+        TriMesh::new(v, t)
+    }
+
+    /// A 3 cm pawn-like solid of revolution, z up, base at z = 0.
+    fn pawn() -> TriMesh {
+        let profile = [
+            (0.0, 0.0),
+            (0.0125, 0.0),
+            (0.0125, 0.003),
+            (0.009, 0.005),
+            (0.006, 0.012),
+            (0.0045, 0.019),
+            (0.007, 0.020),
+            (0.0045, 0.021),
+            (0.0055, 0.024),
+            (0.0052, 0.027),
+            (0.0035, 0.0295),
+            (0.0, 0.030),
+        ];
+        let m = lathe(&profile, 48);
+        assert!(m.is_closed_and_oriented());
+        assert!(m.signed_volume() > 0.0, "lathe must be outward");
+        m
+    }
+
+    // ---------------------------------------------------------------- mesh basics
+
+    #[test]
+    fn box_mesh_is_closed_outward_with_right_volume_and_area() {
+        let m = box_mesh(DVec3::new(-1.0, 0.0, 2.0), DVec3::new(1.0, 0.5, 5.0));
+        assert!(m.is_closed_and_oriented());
+        assert!((m.signed_volume() - 2.0 * 0.5 * 3.0).abs() < 1e-12);
+        let area = 2.0 * (2.0 * 0.5 + 0.5 * 3.0 + 3.0 * 2.0);
+        assert!((m.surface_area() - area).abs() < 1e-12);
+        let mut f = m.clone();
+        f.flip();
+        assert!(f.is_closed_and_oriented());
+        assert!((f.signed_volume() + 3.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn open_or_doubled_meshes_are_not_closed() {
+        let m = box_mesh(DVec3::ZERO, DVec3::ONE);
+        let mut open = m.clone();
+        open.triangles.pop();
+        assert!(!open.is_closed_and_oriented());
+        let mut doubled = m.clone();
+        doubled.triangles.extend(m.triangles.iter().copied());
+        assert!(!doubled.is_closed_and_oriented());
+        // One face turned over: its edges now repeat the neighbours' directions.
+        let mut mixed = m.clone();
+        mixed.triangles[0].swap(1, 2);
+        assert!(!mixed.is_closed_and_oriented());
+        assert!(!TriMesh::default().is_closed_and_oriented());
+    }
+
+    // ---------------------------------------------------------------- mass properties
+
+    #[test]
+    fn sphere_mass_properties_match_closed_form() {
+        // r = 0.1 m water ball: m = 4/3 pi 1e-3 * 1000 = 4.18879 kg, I = 2/5 m r^2.
+        let mp = Shape::Sphere { radius: 0.1 }.mass_properties(1000.0);
+        assert!(rel(mp.mass, 4.188_790_204_786_391) < 1e-14);
+        for i in 0..3 {
+            assert!(rel(mp.principal_inertia[i], 0.016_755_160_819_145_56) < 1e-14);
+        }
+        assert_eq!(mp.local_com, DVec3::ZERO);
+    }
+
+    #[test]
+    fn box_mass_properties_match_closed_form_and_mesh() {
+        let h = DVec3::new(0.1, 0.05, 0.02);
+        let mp = Shape::Cuboid { half_extents: h }.mass_properties(500.0);
+        // m = 500 * 0.2 * 0.1 * 0.04 = 0.4 kg; I_x = m (0.1^2 + 0.04^2) / 12.
+        assert!(rel(mp.mass, 0.4) < 1e-14);
+        let expect = DVec3::new(0.4 * 0.0116 / 12.0, 0.4 * 0.0416 / 12.0, 0.4 * 0.05 / 12.0);
+        assert!((mp.principal_inertia - expect).abs().max_element() < 1e-15 * 0.4);
+        // The same box as a mesh: sorted moments are x, y, z here, so the principal
+        // frame must be a signed permutation of the identity (up to axis signs).
+        let mesh = Shape::Mesh(Arc::new(box_mesh(-h, h))).mass_properties(500.0);
+        assert!(rel(mesh.mass, 0.4) < 1e-13);
+        assert!(mesh.local_com.length() < 1e-16);
+        assert!((mesh.principal_inertia - expect).abs().max_element() < 1e-13 * expect.x);
+        let frame = DMat3::from_quat(mesh.principal_frame);
+        for (k, axis) in [DVec3::X, DVec3::Y, DVec3::Z].iter().enumerate() {
+            assert!((frame.col(k).dot(*axis).abs() - 1.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn unit_cube_mesh_off_origin_matches_closed_form() {
+        let mp = Shape::Mesh(Arc::new(box_mesh(DVec3::ZERO, DVec3::ONE))).mass_properties(2.0);
+        assert!(rel(mp.mass, 2.0) < 1e-14);
+        assert!((mp.local_com - DVec3::splat(0.5)).length() < 1e-15);
+        for i in 0..3 {
+            assert!(rel(mp.principal_inertia[i], 2.0 / 6.0) < 1e-14);
+        }
+    }
+
+    #[test]
+    fn rotated_tiny_box_mesh_recovers_axes_and_moments() {
+        // A 4 x 2 x 1 cm steel-ish brick, rotated and moved away from the origin.
+        let h = DVec3::new(0.02, 0.01, 0.005);
+        let rot = DQuat::from_euler(glam::EulerRot::ZYX, 0.7, -0.4, 1.1);
+        let shift = DVec3::new(0.3, -0.2, 0.9);
+        let mesh = transformed(&box_mesh(-h, h), rot, shift);
+        let mp = Shape::Mesh(Arc::new(mesh)).mass_properties(7800.0);
+        let exact = Shape::Cuboid { half_extents: h }.mass_properties(7800.0);
+        assert!(rel(mp.mass, exact.mass) < 1e-12);
+        assert!((mp.local_com - shift).length() < 1e-15);
+        // Sorted ascending: the long axis x has the smallest moment, z the largest.
+        for k in 0..3 {
+            assert!(rel(mp.principal_inertia[k], exact.principal_inertia[k]) < 1e-10);
+            let got = mp.principal_frame * DVec3::AXES[k];
+            assert!((got.dot(rot * DVec3::AXES[k]).abs() - 1.0).abs() < 1e-12);
+        }
+        let m = DMat3::from_quat(mp.principal_frame);
+        assert!((m.determinant() - 1.0).abs() < 1e-12);
+        // The body-frame tensor reassembles to R diag R^T.
+        let want = DMat3::from_quat(rot)
+            * DMat3::from_diagonal(exact.principal_inertia)
+            * DMat3::from_quat(rot).transpose();
+        let got = mp.inertia_tensor();
+        for c in 0..3 {
+            assert!(
+                (got.col(c) - want.col(c)).abs().max_element() < 1e-10 * exact.principal_inertia.z
+            );
+        }
+    }
+
+    #[test]
+    fn fine_mesh_sphere_approaches_closed_form() {
+        // A 1.5 cm steel ball as an icosphere with 20480 faces. The inscribed polyhedron
+        // loses volume as O(edge^2); measured deficit 5.4e-4 for mass, 9.0e-4 for I.
+        let r = 0.015;
+        let mesh = icosphere(r, 5);
+        assert!(mesh.is_closed_and_oriented());
+        let mp = Shape::Mesh(Arc::new(mesh)).mass_properties(7850.0);
+        let exact = Shape::Sphere { radius: r }.mass_properties(7850.0);
+        assert!(
+            rel(mp.mass, exact.mass) < 1e-3,
+            "{}",
+            rel(mp.mass, exact.mass)
+        );
+        assert!(mp.local_com.length() < 1e-12 * r);
+        for k in 0..3 {
+            let e = rel(mp.principal_inertia[k], exact.principal_inertia[k]);
+            assert!(e < 1.5e-3, "{e}");
+        }
+        // Coarser meshes must be worse: the test can tell convergence from luck.
+        let coarse = Shape::Mesh(Arc::new(icosphere(r, 2))).mass_properties(7850.0);
+        assert!(rel(coarse.mass, exact.mass) > 10.0 * rel(mp.mass, exact.mass));
+    }
+
+    #[test]
+    fn tiny_pawn_gets_its_symmetry_axis_when_rotated_off_axis() {
+        let base = pawn();
+        let density = 0.030 / base.signed_volume(); // 30 g
+        let upright = Shape::Mesh(Arc::new(base.clone())).mass_properties(density);
+        assert!(rel(upright.mass, 0.030) < 1e-12);
+        let rot = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 0.5).normalize(), 0.9);
+        let shift = DVec3::new(0.05, 0.02, -0.01);
+        let tilted = Shape::Mesh(Arc::new(transformed(&base, rot, shift))).mass_properties(density);
+        // Pawn-scale inertia, as in the field notes (~1e-6 .. 1e-5 kg m^2).
+        assert!(tilted.principal_inertia.max_element() < 1e-5);
+        assert!(tilted.principal_inertia.min_element() > 1e-7);
+        let p = tilted.principal_inertia;
+        // Slender: the symmetry axis has the smallest moment and the other two are equal.
+        assert!(rel(p.y, p.z) < 1e-12, "{p}");
+        assert!(p.x < 0.9 * p.y);
+        let axis = tilted.principal_frame * DVec3::X;
+        assert!(
+            (axis.dot(rot * DVec3::Z).abs() - 1.0).abs() < 1e-12,
+            "{axis}"
+        );
+        for k in 0..3 {
+            assert!(rel(p[k], upright.principal_inertia[k]) < 1e-11);
+        }
+        assert!((tilted.local_com - (rot * upright.local_com + shift)).length() < 1e-15);
+        // And the flight picks the exact axisymmetric law for it.
+        let mut f = FreeFlight::default();
+        let cfg = FlightConfig::default();
+        let w = DVec3::new(3.0, -20.0, 7.0);
+        f.reset(
+            &tilted,
+            DVec3::ZERO,
+            DQuat::IDENTITY,
+            DVec3::ZERO,
+            w,
+            DVec3::ZERO,
+            1.5,
+            &cfg,
+        );
+        assert_eq!(f.rotation_kind(), RotationKind::Axisymmetric);
+    }
+
+    // ---------------------------------------------------------------- flight
+
+    /// Independent reference: Euler's equations for the principal-frame angular velocity
+    /// together with the body quaternion, by classical RK4 with a fixed small step.
+    fn reference_rotation(
+        mp: &MassProperties,
+        q0: DQuat,
+        w0: DVec3,
+        t: f64,
+        steps: usize,
+    ) -> DQuat {
+        let inertia = mp.principal_inertia.to_array();
+        let p = mp.principal_frame;
+        let wp0 = (q0 * p).conjugate() * w0;
+        // State: [w1, w2, w3, qx, qy, qz, qw], q = body -> world.
+        let f = |s: &[f64; 7]| -> [f64; 7] {
+            let [i1, i2, i3] = inertia;
+            let (w1, w2, w3) = (s[0], s[1], s[2]);
+            let dw = [
+                (i2 - i3) * w2 * w3 / i1,
+                (i3 - i1) * w3 * w1 / i2,
+                (i1 - i2) * w1 * w2 / i3,
+            ];
+            // Body-frame angular velocity; q' = q (0, w_body) / 2.
+            let wb = p * DVec3::new(w1, w2, w3);
+            let q = DQuat::from_xyzw(s[3], s[4], s[5], s[6]);
+            let dq = q * DQuat::from_xyzw(wb.x, wb.y, wb.z, 0.0) * 0.5;
+            [dw[0], dw[1], dw[2], dq.x, dq.y, dq.z, dq.w]
+        };
+        let mut s = [wp0.x, wp0.y, wp0.z, q0.x, q0.y, q0.z, q0.w];
+        let h = t / steps as f64;
+        let add = |a: &[f64; 7], b: &[f64; 7], c: f64| -> [f64; 7] {
+            std::array::from_fn(|i| a[i] + c * b[i])
+        };
+        for _ in 0..steps {
+            let k1 = f(&s);
+            let k2 = f(&add(&s, &k1, h / 2.0));
+            let k3 = f(&add(&s, &k2, h / 2.0));
+            let k4 = f(&add(&s, &k3, h));
+            s = std::array::from_fn(|i| {
+                s[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            });
+        }
+        DQuat::from_xyzw(s[3], s[4], s[5], s[6]).normalize()
+    }
+
+    fn world_inertia(mp: &MassProperties, r: DQuat) -> DMat3 {
+        let m = DMat3::from_quat(r);
+        m * mp.inertia_tensor() * m.transpose()
+    }
+
+    /// Checks that L = I(t) w(t) stays the launch value and returns the largest relative
+    /// deviations of L and of the kinetic energy 1/2 w . L over `times`.
+    fn conservation(f: &FreeFlight, mp: &MassProperties, times: &[f64]) -> (f64, f64) {
+        let l0 = f.angular_momentum();
+        let e0 = 0.5 * f.angular_velocity(0.0).dot(l0);
+        let (mut dl, mut de) = (0.0f64, 0.0f64);
+        for &t in times {
+            let r = f.orientation(t);
+            let w = f.angular_velocity(t);
+            let l = world_inertia(mp, r) * w;
+            dl = dl.max((l - l0).length() / l0.length());
+            de = de.max(rel(0.5 * w.dot(l), e0));
+        }
+        (dl, de)
+    }
+
+    fn brick() -> MassProperties {
+        Shape::Cuboid {
+            half_extents: DVec3::new(0.05, 0.025, 0.0125),
+        }
+        .mass_properties(600.0)
+    }
+
+    fn grid(t_end: f64, n: usize) -> Vec<f64> {
+        // Irregular sample times so that queries fall between grid points.
+        (0..=n)
+            .map(|i| t_end * (i as f64 / n as f64).powf(1.1))
+            .collect()
+    }
+
+    #[test]
+    fn isotropic_body_spins_about_fixed_axis() {
+        let mp = Shape::Sphere { radius: 0.02 }.mass_properties(1000.0);
+        let q0 = DQuat::from_axis_angle(DVec3::Y, 0.3);
+        let w = DVec3::new(1.0, -4.0, 9.0);
+        let mut f = FreeFlight::default();
+        f.reset(
+            &mp,
+            DVec3::ONE,
+            q0,
+            DVec3::X,
+            w,
+            DVec3::NEG_Z * 9.81,
+            1.5,
+            &FlightConfig::default(),
+        );
+        assert_eq!(f.rotation_kind(), RotationKind::Isotropic);
+        let r = f.orientation(1.5);
+        let want = reference_rotation(&mp, q0, w, 1.5, 20_000);
+        assert!(angle_between(r, want) < 1e-10);
+        assert!(angle_between(r, DQuat::from_scaled_axis(w * 1.5) * q0) < 1e-14);
+        assert!((f.max_angular_speed() - w.length()).abs() < 1e-10);
+    }
+
+    #[test]
+    fn torque_free_symmetric_top_matches_closed_form_precession() {
+        // A symmetric top (I1 = I2 != I3) whose principal frame is rotated against the body
+        // frame, launched in a tilted pose: the closed form must agree with an
+        // independent fine RK4 of Euler's equations to 1e-9 rad after 1.5 s.
+        for (i_perp, i3) in [(2.0e-5, 0.8e-5), (1.0e-5, 1.7e-5)] {
+            let mp = MassProperties {
+                mass: 0.03,
+                local_com: DVec3::new(0.0, 0.0, 0.01),
+                principal_inertia: DVec3::new(i_perp, i_perp, i3),
+                principal_frame: DQuat::from_euler(glam::EulerRot::XYZ, 0.4, -0.7, 0.2),
+            };
+            let q0 = DQuat::from_axis_angle(DVec3::new(0.3, 1.0, -0.2).normalize(), 1.2);
+            let w = DVec3::new(6.0, -14.0, 9.0);
+            let mut f = FreeFlight::default();
+            f.reset(
+                &mp,
+                DVec3::ZERO,
+                q0,
+                DVec3::ZERO,
+                w,
+                DVec3::ZERO,
+                1.5,
+                &FlightConfig::default(),
+            );
+            assert_eq!(f.rotation_kind(), RotationKind::Axisymmetric);
+            let reference = reference_rotation(&mp, q0, w, 1.5, 150_000);
+            let err = angle_between(f.orientation(1.5), reference);
+            assert!(err < 1e-9, "closed form vs reference: {err}");
+            // The naive constant-w rotation is far off, so the comparison has teeth.
+            assert!(angle_between(DQuat::from_scaled_axis(w * 1.5) * q0, reference) > 0.1);
+            let (dl, de) = conservation(&f, &mp, &grid(1.5, 37));
+            assert!(dl < 1e-13 && de < 1e-13, "{dl} {de}");
+            let max_w = (0..=30)
+                .map(|i| f.angular_velocity(i as f64 * 0.05).length())
+                .fold(0.0, f64::max);
+            assert!(max_w <= f.max_angular_speed());
+        }
+    }
+
+    #[test]
+    fn asymmetric_brick_conserves_l_and_energy_and_converges() {
+        let mp = brick();
+        let q0 = DQuat::from_axis_angle(DVec3::new(1.0, -0.5, 0.3).normalize(), 0.8);
+        let w = DVec3::new(11.0, -13.0, 9.0); // |w| ~ 19.3 rad/s
+        let cfg = FlightConfig::default();
+        let mut f = FreeFlight::default();
+        f.reset(&mp, DVec3::ZERO, q0, DVec3::ZERO, w, DVec3::ZERO, 2.0, &cfg);
+        assert_eq!(f.rotation_kind(), RotationKind::Asymmetric);
+        let times = grid(2.0, 101);
+        let (dl, de) = conservation(&f, &mp, &times);
+        assert!(dl < 1e-12, "L drift {dl}");
+        // Measured 1.1e-9 with the default 0.02 rad per step (error ~ angle^4).
+        assert!(de < 2e-9, "energy drift {de}");
+        // 10x finer steps: measured difference 7.1e-7 rad after 2 s; require 2e-6.
+        let fine_cfg = FlightConfig {
+            rk4_max_step: cfg.rk4_max_step / 10.0,
+            rk4_max_angle: cfg.rk4_max_angle / 10.0,
+        };
+        let mut fine = FreeFlight::default();
+        fine.reset(
+            &mp,
+            DVec3::ZERO,
+            q0,
+            DVec3::ZERO,
+            w,
+            DVec3::ZERO,
+            2.0,
+            &fine_cfg,
+        );
+        let ratio = fine.rk4_steps() as f64 / f.rk4_steps() as f64;
+        assert!((ratio - 10.0).abs() < 0.01, "{ratio}");
+        let err = times
+            .iter()
+            .map(|&t| angle_between(f.orientation(t), fine.orientation(t)))
+            .fold(0.0, f64::max);
+        assert!(err < 2e-6, "vs 10x finer: {err}");
+        // Independent Euler-equation reference.
+        let reference = reference_rotation(&mp, q0, w, 2.0, 200_000);
+        let err = angle_between(f.orientation(2.0), reference);
+        assert!(err < 2e-6, "vs Euler reference: {err}");
+        // The gyroscopic motion matters: constant-w rotation is far off.
+        assert!(angle_between(DQuat::from_scaled_axis(w * 2.0) * q0, reference) > 0.1);
+        // The speed bound holds and is tight (the exact polhode maximum): 2 s covers
+        // more than one polhode period here.
+        let max_w = times
+            .iter()
+            .map(|&t| f.angular_velocity(t).length())
+            .fold(0.0, f64::max);
+        assert!(max_w <= f.max_angular_speed());
+        assert!(
+            f.max_angular_speed() < 1.001 * max_w,
+            "{} {max_w}",
+            f.max_angular_speed()
+        );
+    }
+
+    #[test]
+    fn intermediate_axis_flips_and_still_conserves() {
+        // Tennis-racket theorem: spin about the middle axis (y for this brick) with a tiny
+        // perturbation flips over repeatedly.
+        let mp = brick();
+        let w = DVec3::new(0.05, 20.0, 0.0);
+        let mut f = FreeFlight::default();
+        f.reset(
+            &mp,
+            DVec3::ZERO,
+            DQuat::IDENTITY,
+            DVec3::ZERO,
+            w,
+            DVec3::ZERO,
+            2.0,
+            &FlightConfig::default(),
+        );
+        let times = grid(2.0, 400);
+        let body_wy: Vec<f64> = times
+            .iter()
+            .map(|&t| (f.orientation(t).conjugate() * f.angular_velocity(t)).y)
+            .collect();
+        assert!(body_wy.iter().any(|&y| y < -19.0), "the body never flipped");
+        let (dl, de) = conservation(&f, &mp, &times);
+        assert!(dl < 1e-12 && de < 2e-9, "{dl} {de}");
+    }
+
+    #[test]
+    fn angular_velocity_is_the_derivative_of_orientation() {
+        // Central differences inside one grid step, so the partial-step interpolant and
+        // the angular velocity must agree.
+        let mp = brick();
+        let mut f = FreeFlight::default();
+        let w = DVec3::new(-7.0, 15.0, 10.0);
+        f.reset(
+            &mp,
+            DVec3::ZERO,
+            DQuat::IDENTITY,
+            DVec3::ZERO,
+            w,
+            DVec3::ZERO,
+            1.0,
+            &FlightConfig::default(),
+        );
+        let h = 1.0 / f.rk4_steps() as f64;
+        for k in [3usize, 100, 700] {
+            let t = (k as f64 + 0.5) * h;
+            let d = 1e-3 * h;
+            let dq = f.orientation(t + d) * f.orientation(t - d).conjugate();
+            let w_fd = dq.to_scaled_axis() / (2.0 * d);
+            let w_an = f.angular_velocity(t);
+            assert!(
+                (w_fd - w_an).length() < 1e-6 * w_an.length(),
+                "{w_fd} {w_an}"
+            );
+        }
+    }
+
+    #[test]
+    fn queries_beyond_t_max_extend_the_integration() {
+        let mp = brick();
+        let w = DVec3::new(5.0, 8.0, -12.0);
+        let cfg = FlightConfig::default();
+        let (mut short, mut long) = (FreeFlight::default(), FreeFlight::default());
+        short.reset(
+            &mp,
+            DVec3::ZERO,
+            DQuat::IDENTITY,
+            DVec3::ZERO,
+            w,
+            DVec3::ZERO,
+            0.5,
+            &cfg,
+        );
+        long.reset(
+            &mp,
+            DVec3::ZERO,
+            DQuat::IDENTITY,
+            DVec3::ZERO,
+            w,
+            DVec3::ZERO,
+            1.5,
+            &cfg,
+        );
+        for t in [0.7, 1.3] {
+            let err = angle_between(short.orientation(t), long.orientation(t));
+            assert!(err < 1e-8, "t = {t}: {err}");
+        }
+        // Negative times integrate backwards: relaunching from the pose and angular
+        // velocity at -0.4 s must come back to the launch pose 0.4 s later.
+        let (q, wq) = (short.orientation(-0.4), short.angular_velocity(-0.4));
+        let mut back = FreeFlight::default();
+        back.reset(&mp, DVec3::ZERO, q, DVec3::ZERO, wq, DVec3::ZERO, 0.5, &cfg);
+        let err = angle_between(back.orientation(0.4), DQuat::IDENTITY);
+        assert!(err < 1e-8, "{err}");
+        assert!(angle_between(q, DQuat::IDENTITY) > 0.5);
+    }
+
+    #[test]
+    fn origin_and_com_stay_consistent_for_off_centre_mesh() {
+        let mesh = box_mesh(DVec3::new(0.01, -0.02, 0.0), DVec3::new(0.05, 0.0, 0.01));
+        let mp = Shape::Mesh(Arc::new(mesh)).mass_properties(700.0);
+        assert!(mp.local_com.length() > 0.01);
+        let origin = DVec3::new(0.1, 0.2, 0.8);
+        let q0 = DQuat::from_axis_angle(DVec3::new(1.0, 1.0, 0.0).normalize(), 0.6);
+        let (v, w, g) = (
+            DVec3::new(1.0, 0.5, 4.0),
+            DVec3::new(9.0, -5.0, 14.0),
+            DVec3::new(0.0, 0.0, -9.81),
+        );
+        let mut f = FreeFlight::default();
+        f.reset(&mp, origin, q0, v, w, g, 1.5, &FlightConfig::default());
+        assert_eq!(f.rotation_kind(), RotationKind::Asymmetric);
+        assert!((f.origin(0.0) - origin).length() < 1e-15);
+        assert!(angle_between(f.orientation(0.0), q0) < 1e-15);
+        let com0 = origin + q0 * mp.local_com;
+        for t in [0.0, 0.31, 0.9, 1.5] {
+            let (o, r) = f.pose(t);
+            assert!((o + r * mp.local_com - f.com(t)).length() < 1e-14);
+            assert!((o - f.origin(t)).length() < 1e-15);
+            let want = com0 + v * t + 0.5 * g * t * t;
+            assert!((f.com(t) - want).length() < 1e-14);
+            assert!((f.com_velocity(t) - (v + g * t)).length() < 1e-14);
+        }
+        // t = 1.5 s under gravity: the COM is 11.04 m below the no-gravity line.
+        assert!((f.com(1.5).z - (com0.z + 6.0 - 11.03625)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn reset_reuses_its_buffer() {
+        let mp = brick();
+        let cfg = FlightConfig::default();
+        let mut f = FreeFlight::default();
+        let w = DVec3::new(3.0, 20.0, 1.0);
+        f.reset(
+            &mp,
+            DVec3::ZERO,
+            DQuat::IDENTITY,
+            DVec3::ZERO,
+            w,
+            DVec3::ZERO,
+            1.5,
+            &cfg,
+        );
+        let (ptr, cap) = (f.states.as_ptr(), f.states.capacity());
+        f.reset(
+            &mp,
+            DVec3::ZERO,
+            DQuat::IDENTITY,
+            DVec3::ZERO,
+            w * 0.9,
+            DVec3::ZERO,
+            1.5,
+            &cfg,
+        );
+        assert_eq!((ptr, cap), (f.states.as_ptr(), f.states.capacity()));
+        // A closed-form reset leaves the buffer alone as well.
+        let ball = Shape::Sphere { radius: 0.01 }.mass_properties(1.0);
+        f.reset(
+            &ball,
+            DVec3::ZERO,
+            DQuat::IDENTITY,
+            DVec3::ZERO,
+            w,
+            DVec3::ZERO,
+            1.5,
+            &cfg,
+        );
+        assert_eq!(f.rk4_steps(), 0);
+        assert_eq!(cap, f.states.capacity());
+    }
+
+    // ---------------------------------------------------------------- shapes
+
+    #[test]
+    fn support_and_bounding_radius() {
+        let h = DVec3::new(1.0, 2.0, 3.0);
+        let cube = Shape::Cuboid { half_extents: h };
+        assert_eq!(
+            cube.support(DVec3::new(1.0, -1.0, 0.0)),
+            DVec3::new(1.0, -2.0, 3.0)
+        );
+        let about = DVec3::new(0.5, -1.0, 0.0);
+        assert!((cube.bounding_radius(about) - DVec3::new(1.5, 3.0, 3.0).length()).abs() < 1e-15);
+        let mesh = Shape::Mesh(Arc::new(box_mesh(-h, h)));
+        assert_eq!(
+            mesh.support(DVec3::new(1.0, -1.0, 0.1)),
+            DVec3::new(1.0, -2.0, 3.0)
+        );
+        assert!((mesh.bounding_radius(about) - cube.bounding_radius(about)).abs() < 1e-15);
+        let ball = Shape::Sphere { radius: 2.0 };
+        assert!(
+            (ball.support(DVec3::new(0.0, 3.0, 4.0)) - DVec3::new(0.0, 1.2, 1.6)).length() < 1e-15
+        );
+        assert_eq!(ball.bounding_radius(DVec3::new(3.0, 4.0, 0.0)), 7.0);
+        assert!((mesh.volume() - cube.volume()).abs() < 1e-12);
+    }
+
+    // ---------------------------------------------------------------- OBJ loading
+
+    fn temp_obj(name: &str, text: &str) -> PathBuf {
+        let path =
+            std::env::temp_dir().join(format!("body-test-{}-{name}.obj", std::process::id()));
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    const CUBE_OBJ: &str = "\
+# unit cube, quads with per-face normals (so single_index splits the corners)
+v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1
+vn 0 0 -1\nvn 0 0 1\nvn 0 -1 0\nvn 0 1 0\nvn -1 0 0\nvn 1 0 0
+o bottom
+f 1//1 4//1 3//1 2//1
+o rest
+f 5//2 6//2 7//2 8//2
+f 1//3 2//3 6//3 5//3
+f 4//4 8//4 7//4 3//4
+f 1//5 5//5 8//5 4//5
+f 2//6 3//6 7//6 6//6
+";
+
+    #[test]
+    fn load_obj_unit_cube_welds_and_scales() {
+        let path = temp_obj("cube", CUBE_OBJ);
+        let mesh = load_obj(&path, 0.05).unwrap();
+        std::fs::remove_file(&path).ok();
+        assert_eq!(mesh.vertices.len(), 8);
+        assert_eq!(mesh.triangles.len(), 12);
+        assert!(mesh.is_closed_and_oriented());
+        assert!(rel(mesh.signed_volume(), 0.05f64.powi(3)) < 1e-6);
+        let mp = Shape::Mesh(Arc::new(mesh)).mass_properties(1000.0);
+        assert!((mp.local_com - DVec3::splat(0.025)).length() < 1e-8);
+    }
+
+    #[test]
+    fn load_obj_flips_inward_mesh() {
+        // The same cube with every face wound clockwise seen from outside.
+        let inward: String = CUBE_OBJ
+            .lines()
+            .map(|l| {
+                if let Some(rest) = l.strip_prefix("f ") {
+                    let mut v: Vec<&str> = rest.split_whitespace().collect();
+                    v.reverse();
+                    format!("f {}\n", v.join(" "))
+                } else {
+                    format!("{l}\n")
+                }
+            })
+            .collect();
+        let path = temp_obj("inward", &inward);
+        let mesh = load_obj(&path, 1.0).unwrap();
+        std::fs::remove_file(&path).ok();
+        assert!(mesh.is_closed_and_oriented());
+        assert!(rel(mesh.signed_volume(), 1.0) < 1e-12);
+    }
+
+    #[test]
+    fn load_obj_reports_errors() {
+        let path = temp_obj("nofaces", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\n");
+        let err = load_obj(&path, 1.0).unwrap_err();
+        std::fs::remove_file(&path).ok();
+        assert!(matches!(err, ObjError::NoFaces { .. }), "{err}");
+
+        let missing = std::env::temp_dir().join("body-test-does-not-exist.obj");
+        let err = load_obj(&missing, 1.0).unwrap_err();
+        assert!(matches!(err, ObjError::Load { .. }), "{err}");
+
+        let path = temp_obj(
+            "flat",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 4 3 2 1\n",
+        );
+        let err = load_obj(&path, 1.0).unwrap_err();
+        std::fs::remove_file(&path).ok();
+        assert!(matches!(err, ObjError::DegenerateVolume { .. }), "{err}");
+
+        let path = temp_obj("cube-inf", CUBE_OBJ);
+        let err = load_obj(&path, f64::INFINITY).unwrap_err();
+        std::fs::remove_file(&path).ok();
+        assert!(matches!(err, ObjError::NonFiniteVertex { .. }), "{err}");
+    }
+}

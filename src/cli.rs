@@ -1,0 +1,473 @@
+//! The `bsa` command line: argument parsing and the subcommands.
+//!
+//! Subcommands: `check` (validate a scene and print a summary), `solve` (optimise and
+//! write `export/<scene>/`), `eval` (print every energy term of a saved solution).
+//! This is the only module that uses `anyhow`, prints, draws progress bars or installs
+//! the Ctrl-C handler; library modules return typed errors.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use crate::body::Shape;
+use crate::energy::{Term, Weights};
+use crate::evaluate::Problem;
+use crate::export;
+use crate::scene::{self, Scene, Stage, Strategy};
+use crate::solver::{self, IterationInfo, Observer, SampleRecord, Solution, SolveOptions};
+
+#[derive(Parser)]
+#[command(
+    name = "bsa",
+    version,
+    about = "Ballistic shadow art: launch objects so that their shadows form a picture at one instant"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Validate a scene and print a summary.
+    Check {
+        /// Scene folder (holding scene.json) or scene file.
+        scene: PathBuf,
+    },
+    /// Optimise launch velocities and write solution.json, shadow.png, overlay.png,
+    /// convergence.csv and convergence.png.
+    Solve {
+        /// Scene folder (holding scene.json) or scene file.
+        scene: PathBuf,
+        /// Output folder [default: export/<scene name>].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Random seed (overrides the scene's).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Worker threads [default: one per core].
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Continue from the output folder's solution.json (skips its completed stages).
+        #[arg(long)]
+        resume: bool,
+        /// Print the performance report (stages, iterations, samples, time per term).
+        #[arg(long)]
+        report: bool,
+        /// No progress bars.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Print every energy term of a solution, raw and weighted.
+    Eval {
+        /// Scene folder (holding scene.json) or scene file.
+        scene: PathBuf,
+        /// The solution.json to evaluate.
+        #[arg(long)]
+        solution: PathBuf,
+        /// Weights of this stage (1-based) [default: the last stage].
+        #[arg(long)]
+        stage: Option<usize>,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+/// Run the parsed command line.
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Check { scene } => check(&scene),
+        Command::Solve {
+            scene,
+            out,
+            seed,
+            threads,
+            resume,
+            report,
+            quiet,
+        } => solve(&scene, out, seed, threads, resume, report, quiet),
+        Command::Eval {
+            scene,
+            solution,
+            stage,
+            json,
+        } => eval(&scene, &solution, stage, json),
+    }
+}
+
+fn load_scene(path: &Path) -> Result<Scene> {
+    scene::load(path).with_context(|| format!("invalid scene {}", path.display()))
+}
+
+fn fmt_vec(v: glam::DVec3) -> String {
+    format!("({:.3}, {:.3}, {:.3})", v.x, v.y, v.z)
+}
+
+fn check(path: &Path) -> Result<()> {
+    let s = load_scene(path)?;
+    println!("scene `{}` ({})", s.name, s.source.display());
+    println!(
+        "  target   {} x {} px, {} shadow pixels ({:.1}%)",
+        s.target.width(),
+        s.target.height(),
+        s.target.count(),
+        100.0 * s.target.count() as f64 / (s.target.width() * s.target.height()) as f64
+    );
+    println!(
+        "  t        {} s, timestep {:.5} s, gravity {}",
+        s.t,
+        s.dt,
+        fmt_vec(s.gravity)
+    );
+    println!("  light    {}", fmt_vec(s.light));
+    let r = &s.receiver;
+    println!(
+        "  receiver centre {}, u {}, v {}, {} m x {} m ({:.4} m/px)",
+        fmt_vec(r.center),
+        fmt_vec(r.u),
+        fmt_vec(r.v),
+        r.width,
+        r.height,
+        r.width / s.target.width() as f64
+    );
+    match &s.table {
+        Some(t) => println!(
+            "  table    top at z = {:.3} m, centre {}, size {}",
+            t.top(),
+            fmt_vec(t.center),
+            fmt_vec(t.half_extents * 2.0)
+        ),
+        None => println!("  table    none"),
+    }
+    println!("  occluders ({}):", s.occluders.len());
+    for o in &s.occluders {
+        let shape = match &o.shape {
+            Shape::Sphere { radius } => format!("sphere r {radius} m"),
+            Shape::Cuboid { half_extents } => format!("box {}", fmt_vec(*half_extents * 2.0)),
+            Shape::Mesh(m) => format!(
+                "mesh {} vertices, {} triangles",
+                m.vertices.len(),
+                m.triangles.len()
+            ),
+        };
+        println!(
+            "    {:<12} {:<34} {:>8.4} kg  at {}  {}",
+            o.name,
+            shape,
+            o.mass.mass,
+            fmt_vec(o.position),
+            if o.launched { "launched" } else { "stays put" }
+        );
+    }
+    println!("  hints    {}", s.hints.len());
+    match &s.strategy {
+        Strategy::Scheduled => println!("  strategy scheduled, {} stages", s.stages.len()),
+        Strategy::Sequential { order } => println!(
+            "  strategy sequential: {}",
+            order
+                .iter()
+                .map(|&i| s.occluders[i].name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+    for (k, st) in s.stages.iter().enumerate() {
+        let w: Vec<String> = Term::ALL
+            .iter()
+            .filter(|t| st.weights.uses(**t))
+            .map(|t| format!("{}={}", t.key(), st.weights.get(*t)))
+            .collect();
+        println!(
+            "    stage {} `{}`: vary {}, step {}, population {}, max {} iterations; weights {}",
+            k + 1,
+            st.name,
+            st.vary.len(),
+            st.step,
+            st.population,
+            st.max_iterations,
+            w.join(" ")
+        );
+    }
+    println!("  seed     {}", s.seed);
+    println!("ok");
+    Ok(())
+}
+
+static INTERRUPTS: AtomicUsize = AtomicUsize::new(0);
+
+struct CliObserver {
+    out: PathBuf,
+    target: crate::mask::Mask,
+    stage_names: Vec<String>,
+    prior: Vec<SampleRecord>,
+    bar: Option<ProgressBar>,
+    quiet: bool,
+    last_preview: Instant,
+    stages_total: usize,
+    error: Option<anyhow::Error>,
+}
+
+impl Observer for CliObserver {
+    fn stage_started(&mut self, index: usize, stage: &Stage) {
+        let bar = ProgressBar::new(stage.max_iterations as u64);
+        if self.quiet {
+            bar.set_draw_target(ProgressDrawTarget::hidden());
+        }
+        bar.set_style(
+            ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} it {msg}")
+                .expect("static template")
+                .progress_chars("=> "),
+        );
+        bar.set_prefix(format!(
+            "stage {}/{} {}",
+            index + 1,
+            self.stages_total,
+            stage.name
+        ));
+        self.bar = Some(bar);
+    }
+
+    fn iteration(&mut self, info: &IterationInfo) {
+        if let Some(bar) = &self.bar {
+            bar.set_position(info.iteration as u64);
+            bar.set_message(format!(
+                "| {:.0} samples/s | best {:.4e} | IoU {:.4}",
+                info.samples_per_second, info.best_energy, info.best_iou
+            ));
+        }
+        // The preview is refreshed at most ten times a second: encoding a PNG every
+        // iteration would cost more than the optimisation itself on small scenes.
+        if self.last_preview.elapsed().as_secs_f64() >= 0.1 {
+            self.last_preview = Instant::now();
+            if let Err(e) = export::write_preview(&self.out, &self.target, info.best_shadow) {
+                self.error.get_or_insert(e.into());
+            }
+        }
+    }
+
+    fn stage_finished(&mut self, s: &Solution, records: &[SampleRecord]) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
+        }
+        if let Some(r) = s.stages.last() {
+            eprintln!(
+                "stage {}/{} `{}`: {} iterations, {} samples, best energy {:.4e}, IoU {:.4}, {:.2} s ({})",
+                s.stages_completed, s.stages_total, r.name, r.iterations, r.samples, r.best_energy, r.iou, r.wall_time_s, r.stop
+            );
+        }
+        let mut all = self.prior.clone();
+        all.extend_from_slice(records);
+        let res = export::write_solution(&self.out, s)
+            .and_then(|_| export::write_convergence(&self.out, &self.stage_names, &all));
+        if let Err(e) = res {
+            self.error.get_or_insert(e.into());
+        }
+    }
+}
+
+fn solve(
+    path: &Path,
+    out: Option<PathBuf>,
+    seed: Option<u64>,
+    threads: Option<usize>,
+    resume: bool,
+    report: bool,
+    quiet: bool,
+) -> Result<()> {
+    let scene = load_scene(path)?;
+    let out = out.unwrap_or_else(|| PathBuf::from("export").join(&scene.name));
+    if threads == Some(0) {
+        bail!("--threads must be at least 1");
+    }
+    let problem = Problem::new(scene);
+    let scene = &problem.scene;
+    let mut prior = Vec::new();
+    let resume_from = if resume {
+        let file = out.join("solution.json");
+        let s = export::read_solution(&file)
+            .with_context(|| format!("cannot resume from {}", out.display()))?;
+        solver::check_solution(&problem, &s)
+            .with_context(|| format!("cannot resume from {}", file.display()))?;
+        if s.stages_total != scene.stages.len() {
+            bail!(
+                "cannot resume from {}: it has {} stages, the scene has {}",
+                file.display(),
+                s.stages_total,
+                scene.stages.len()
+            );
+        }
+        if s.stages_completed >= s.stages_total {
+            eprintln!(
+                "{}: all {} stages are done already; nothing to resume",
+                file.display(),
+                s.stages_total
+            );
+            return Ok(());
+        }
+        let conv = out.join("convergence.csv");
+        if conv.exists() {
+            prior = export::read_convergence(&conv, s.stages_completed)?;
+        }
+        eprintln!(
+            "resuming after stage {}/{}",
+            s.stages_completed, s.stages_total
+        );
+        Some(s)
+    } else {
+        None
+    };
+    std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
+    ctrlc::set_handler(|| {
+        let n = INTERRUPTS.fetch_add(1, Ordering::SeqCst) + 1;
+        if n == 1 {
+            eprintln!("\ninterrupt: ending this stage (press Ctrl-C again to stop and save the best so far)");
+        } else {
+            eprintln!("\ninterrupt: stopping and saving the best so far");
+        }
+    })
+    .context("cannot install the Ctrl-C handler")?;
+    let mut observer = CliObserver {
+        out: out.clone(),
+        target: scene.target.clone(),
+        stage_names: scene.stages.iter().map(|s| s.name.clone()).collect(),
+        prior: prior.clone(),
+        bar: None,
+        quiet,
+        last_preview: Instant::now() - std::time::Duration::from_secs(1),
+        stages_total: scene.stages.len(),
+        error: None,
+    };
+    let options = SolveOptions {
+        threads,
+        seed,
+        resume: resume_from,
+    };
+    let (solution, records) = solver::solve(&problem, &options, &mut observer, &INTERRUPTS);
+    if let Some(e) = observer.error.take() {
+        return Err(e.context("while saving progress"));
+    }
+    let mut all = prior;
+    all.extend(records);
+    export::write_solution(&out, &solution)?;
+    export::write_convergence(&out, &observer.stage_names, &all)?;
+    let mut ws = problem.workspace();
+    let params = solution.parameters();
+    problem.evaluate(&params, &Weights::all_ones(), &mut ws);
+    export::write_pictures(&out, &scene.target, &ws.mask)?;
+    export::write_preview(&out, &scene.target, &ws.mask)?;
+    println!(
+        "{}: IoU at t {:.4}, {} before t ({} contacts), {} samples in {} iterations, {:.2} s on {} threads{}",
+        scene.name,
+        solution.iou,
+        if solution.n_contacts == 0 {
+            "no contact".to_string()
+        } else {
+            format!("first contact at {:.4} s", solution.t_sim)
+        },
+        solution.n_contacts,
+        solution.samples,
+        solution.iterations,
+        solution.wall_time_s,
+        solution.threads,
+        if solution.complete { "" } else { " (stopped early)" }
+    );
+    println!("wrote {}", out.display());
+    if report {
+        print_report(&solution);
+    }
+    Ok(())
+}
+
+fn print_report(s: &Solution) {
+    println!("\nPerformance (as the paper's Tables 3 and 4)");
+    let n = s.stages.len().max(1) as f64;
+    println!("  stages               {}", s.stages.len());
+    println!("  total iterations     {}", s.iterations);
+    println!("  average iterations   {:.2}", s.iterations as f64 / n);
+    println!("  total samples        {}", s.samples);
+    println!("  average samples      {:.1}", s.samples as f64 / n);
+    println!(
+        "  total running time   {:.2} s ({} threads)",
+        s.wall_time_s, s.threads
+    );
+    println!("  time per sample phase (one core, microseconds):");
+    for (k, v) in &s.time_per_term_us {
+        println!("    {k:<26} {v:>10.2}");
+    }
+}
+
+fn eval(scene_path: &Path, solution_path: &Path, stage: Option<usize>, json: bool) -> Result<()> {
+    let scene = load_scene(scene_path)?;
+    let problem = Problem::new(scene);
+    let s = export::read_solution(solution_path)?;
+    solver::check_solution(&problem, &s)
+        .with_context(|| format!("{} does not match the scene", solution_path.display()))?;
+    let scene = &problem.scene;
+    let k = match stage {
+        None => scene.stages.len(),
+        Some(k) if (1..=scene.stages.len()).contains(&k) => k,
+        Some(k) => bail!(
+            "--stage {k} is out of range: the scene has stages 1 to {}",
+            scene.stages.len()
+        ),
+    };
+    let weights = scene.stages[k - 1].weights;
+    let mut ws = problem.workspace();
+    let e = problem.evaluate(&s.parameters(), &Weights::all_ones(), &mut ws);
+    let mut total = 0.0;
+    let rows: Vec<(Term, f64, f64, f64)> = Term::ALL
+        .iter()
+        .map(|&t| {
+            let raw = e.raw[t as usize];
+            let w = weights.get(t);
+            total += raw * w;
+            (t, raw, w, raw * w)
+        })
+        .collect();
+    if json {
+        let terms: serde_json::Map<String, serde_json::Value> = rows
+            .iter()
+            .map(|(t, raw, w, wt)| {
+                (
+                    t.key().to_string(),
+                    serde_json::json!({"raw": raw, "weight": w, "weighted": wt}),
+                )
+            })
+            .collect();
+        let v = serde_json::json!({
+            "scene": scene.name,
+            "stage": k,
+            "terms": terms,
+            "total": total,
+            "iou": e.iou,
+            "t_sim": e.outcome.t_sim,
+            "n_contacts": e.outcome.n_contacts,
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        println!(
+            "scene `{}`, weights of stage {} `{}`",
+            scene.name,
+            k,
+            scene.stages[k - 1].name
+        );
+        println!(
+            "{:<16} {:>14} {:>10} {:>14}",
+            "term", "raw", "weight", "weighted"
+        );
+        for (t, raw, w, wt) in &rows {
+            println!("{:<16} {:>14.6} {:>10} {:>14.6}", t.label(), raw, w, wt);
+        }
+        println!("{:<16} {:>14} {:>10} {:>14.6}", "total", "", "", total);
+        println!(
+            "IoU at t {:.5}; t_sim {:.5} s; contacts {}",
+            e.iou, e.outcome.t_sim, e.outcome.n_contacts
+        );
+    }
+    Ok(())
+}

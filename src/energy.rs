@@ -1,0 +1,388 @@
+//! The paper's ten energy terms, computed from a shadow mask and the flight outcome.
+//!
+//! Main types: [`Term`] (the ten terms, in a fixed order), [`Weights`] (one stage's
+//! weights), [`TargetData`] (everything about the target picture that never changes:
+//! its mask, inner and outer boundary masks, moments) and [`image_terms`], which fills
+//! the image terms of a raw energy vector from a shadow mask.
+//!
+//! Data flow: `evaluate` rasterizes the shadow at `t` into a [`Mask`], calls
+//! [`image_terms`] for the moment, XOR and boundary terms, and adds the physics
+//! (contact, regularization) and scene (hints, barrier) terms itself.
+//!
+//! Deviations from the printed paper, by its text's intent (see `docs/energies.md`):
+//! `E_in` counts inner-boundary pixels the shadow fails to cover, `E_out` counts
+//! outer-boundary pixels the shadow covers, and `E_XOR` counts pixels that differ.
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+use crate::mask::{Mask, Moments};
+
+/// Number of energy terms.
+pub const TERM_COUNT: usize = 10;
+
+/// The energy terms, in the order used by every array of term values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[repr(usize)]
+pub enum Term {
+    /// |M0(shadow) - M0(target)|, pixels.
+    D0 = 0,
+    /// Distance between the centroids, pixels.
+    D1,
+    /// Euclidean distance between (mu20, mu11, mu02) vectors, pixels^2.
+    D2,
+    /// Pixels where shadow and target differ.
+    Xor,
+    /// Inner-boundary pixels of the target not covered by the shadow.
+    Inner,
+    /// Outer-boundary pixels of the target covered by the shadow.
+    Outer,
+    /// (t - t_sim) * n_contact, seconds.
+    Contact,
+    /// alpha * sum |v| + (1 - alpha) * sum |w| over launched occluders (alpha = 0.5).
+    Reg,
+    /// sum of w_h * |P(x_h) - p_h| over hints, pixels.
+    Hint,
+    /// sum of B(P(C_i)): distance (pixels) of projected centres of mass outside the
+    /// circle of half the image height around the image centre.
+    Barrier,
+}
+
+impl Term {
+    pub const ALL: [Term; TERM_COUNT] = [
+        Term::D0,
+        Term::D1,
+        Term::D2,
+        Term::Xor,
+        Term::Inner,
+        Term::Outer,
+        Term::Contact,
+        Term::Reg,
+        Term::Hint,
+        Term::Barrier,
+    ];
+
+    /// The key used in scene files, CSV headers and JSON.
+    pub fn key(self) -> &'static str {
+        match self {
+            Term::D0 => "d0",
+            Term::D1 => "d1",
+            Term::D2 => "d2",
+            Term::Xor => "xor",
+            Term::Inner => "inner",
+            Term::Outer => "outer",
+            Term::Contact => "contact",
+            Term::Reg => "reg",
+            Term::Hint => "hint",
+            Term::Barrier => "barrier",
+        }
+    }
+
+    /// A longer name for tables and plots.
+    pub fn label(self) -> &'static str {
+        match self {
+            Term::D0 => "0th moment",
+            Term::D1 => "1st moment",
+            Term::D2 => "2nd moment",
+            Term::Xor => "XOR",
+            Term::Inner => "inner boundary",
+            Term::Outer => "outer boundary",
+            Term::Contact => "contact",
+            Term::Reg => "regularization",
+            Term::Hint => "hints",
+            Term::Barrier => "barrier",
+        }
+    }
+
+    /// Parse a scene-file key; a few long aliases are accepted too.
+    pub fn from_key(key: &str) -> Option<Term> {
+        let t = match key {
+            "d0" | "moment0" => Term::D0,
+            "d1" | "moment1" => Term::D1,
+            "d2" | "moment2" => Term::D2,
+            "xor" => Term::Xor,
+            "inner" => Term::Inner,
+            "outer" => Term::Outer,
+            "contact" => Term::Contact,
+            "reg" | "regularization" => Term::Reg,
+            "hint" | "hints" => Term::Hint,
+            "barrier" => Term::Barrier,
+            _ => return None,
+        };
+        Some(t)
+    }
+}
+
+/// One stage's weights, indexed by [`Term`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Weights(pub [f64; TERM_COUNT]);
+
+impl Weights {
+    pub fn get(&self, t: Term) -> f64 {
+        self.0[t as usize]
+    }
+
+    /// Whether a term contributes at all (zero-weight terms are skipped in the hot loop).
+    pub fn uses(&self, t: Term) -> bool {
+        self.0[t as usize] != 0.0
+    }
+
+    /// A weight vector with every term on (used by `bsa eval` to compute everything).
+    pub fn all_ones() -> Weights {
+        Weights([1.0; TERM_COUNT])
+    }
+}
+
+/// The weighting of linear against angular speed in the regularization (the paper's alpha).
+pub const REG_ALPHA: f64 = 0.5;
+
+/// Side of the square structuring element for the boundary images (the paper's 5 x 5).
+pub const BOUNDARY_KERNEL: usize = 5;
+
+/// Everything about the target picture that the energies need, computed once per scene.
+#[derive(Clone, Debug)]
+pub struct TargetData {
+    pub mask: Mask,
+    /// Target minus its erosion: the band just inside the outline.
+    pub inner: Mask,
+    /// Dilation minus the target: the band just outside the outline.
+    pub outer: Mask,
+    pub moments: Moments,
+    /// Shadow-free fallbacks: the image diagonal (pixels), used when a centroid is undefined.
+    pub diagonal: f64,
+    /// Image centre (pixels) and barrier radius (half the image height, pixels).
+    pub center: DVec2,
+    pub barrier_radius: f64,
+}
+
+impl TargetData {
+    pub fn new(mask: &Mask) -> TargetData {
+        let inner = mask.and_not(&mask.erode(BOUNDARY_KERNEL));
+        let outer = mask.dilate(BOUNDARY_KERNEL).and_not(mask);
+        let (w, h) = (mask.width() as f64, mask.height() as f64);
+        TargetData {
+            mask: mask.clone(),
+            inner,
+            outer,
+            moments: mask.moments(),
+            diagonal: (w * w + h * h).sqrt(),
+            center: DVec2::new(w / 2.0, h / 2.0),
+            barrier_radius: h / 2.0,
+        }
+    }
+
+    /// The barrier B(x) of one projected point (pixels); `None` (no projection: the
+    /// point is at or behind the light) costs ten image diagonals.
+    pub fn barrier(&self, p: Option<DVec2>) -> f64 {
+        match p {
+            Some(p) if p.is_finite() => {
+                let d = p.distance(self.center);
+                if d < self.barrier_radius {
+                    0.0
+                } else {
+                    d
+                }
+            }
+            _ => 10.0 * self.diagonal,
+        }
+    }
+
+    /// Distance (pixels) of a projected hint point from its target pixel, with the same
+    /// fallback as [`TargetData::barrier`] when the point does not project.
+    pub fn hint_distance(&self, p: Option<DVec2>, target: DVec2) -> f64 {
+        match p {
+            Some(p) if p.is_finite() => p.distance(target),
+            _ => 10.0 * self.diagonal,
+        }
+    }
+}
+
+/// Fill the image terms (d0, d1, d2, XOR, inner, outer) of `raw` from the shadow mask.
+/// Terms whose weight is zero are skipped (left at 0) to save time; pass
+/// [`Weights::all_ones`] to compute them all.
+pub fn image_terms(
+    target: &TargetData,
+    shadow: &Mask,
+    weights: &Weights,
+    raw: &mut [f64; TERM_COUNT],
+) {
+    if weights.uses(Term::D0) || weights.uses(Term::D1) || weights.uses(Term::D2) {
+        let m = shadow.moments();
+        let tm = &target.moments;
+        raw[Term::D0 as usize] = (m.count - tm.count).abs();
+        match (m.centroid(), tm.centroid()) {
+            (Some(a), Some(b)) => raw[Term::D1 as usize] = a.distance(b),
+            _ => raw[Term::D1 as usize] = target.diagonal,
+        }
+        match (m.central_second(), tm.central_second()) {
+            (Some(a), Some(b)) => {
+                let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+                raw[Term::D2 as usize] = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            }
+            (None, Some(b)) => {
+                raw[Term::D2 as usize] = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt()
+            }
+            _ => raw[Term::D2 as usize] = 0.0,
+        }
+    }
+    if weights.uses(Term::Xor) {
+        raw[Term::Xor as usize] = shadow.xor_count(&target.mask) as f64;
+    }
+    if weights.uses(Term::Inner) {
+        raw[Term::Inner as usize] = target.inner.and_not_count(shadow) as f64;
+    }
+    if weights.uses(Term::Outer) {
+        raw[Term::Outer as usize] = target.outer.and_count(shadow) as f64;
+    }
+}
+
+/// Intersection over union of two masks (1 when both are empty).
+pub fn iou(a: &Mask, b: &Mask) -> f64 {
+    let inter = a.and_count(b) as f64;
+    let union = a.count() as f64 + b.count() as f64 - inter;
+    if union == 0.0 {
+        1.0
+    } else {
+        inter / union
+    }
+}
+
+/// Weighted total of raw term values. A non-finite total (a diverged sample) becomes a
+/// huge finite energy so that the optimizer ranks it last instead of failing.
+pub fn weighted_total(raw: &[f64; TERM_COUNT], weights: &Weights) -> f64 {
+    let total: f64 = raw.iter().zip(weights.0.iter()).map(|(r, w)| r * w).sum();
+    if total.is_finite() {
+        total
+    } else {
+        DIVERGED_ENERGY
+    }
+}
+
+/// The energy given to a sample whose evaluation produced NaN or infinity.
+pub const DIVERGED_ENERGY: f64 = 1e30;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn disc(w: usize, h: usize, cx: f64, cy: f64, r: f64) -> Mask {
+        Mask::from_fn(w, h, |x, y| {
+            let (dx, dy) = (x as f64 + 0.5 - cx, y as f64 + 0.5 - cy);
+            dx * dx + dy * dy <= r * r
+        })
+    }
+
+    fn terms(target: &Mask, shadow: &Mask) -> [f64; TERM_COUNT] {
+        let td = TargetData::new(target);
+        let mut raw = [0.0; TERM_COUNT];
+        image_terms(&td, shadow, &Weights::all_ones(), &mut raw);
+        raw
+    }
+
+    #[test]
+    fn identical_masks_cost_nothing() {
+        let t = disc(128, 96, 60.0, 40.0, 20.0);
+        let raw = terms(&t, &t);
+        for term in [
+            Term::D0,
+            Term::D1,
+            Term::D2,
+            Term::Xor,
+            Term::Inner,
+            Term::Outer,
+        ] {
+            assert_eq!(raw[term as usize], 0.0, "{term:?}");
+        }
+    }
+
+    #[test]
+    fn shifted_disc_moments_and_xor() {
+        let t = disc(128, 96, 60.0, 40.0, 20.0);
+        let s = disc(128, 96, 63.0, 44.0, 20.0);
+        let raw = terms(&t, &s);
+        // Same area (up to pixelisation at integer offsets: exactly the same pixel set shifted).
+        assert_eq!(raw[Term::D0 as usize], 0.0);
+        assert!(
+            (raw[Term::D1 as usize] - 5.0).abs() < 1e-9,
+            "{}",
+            raw[Term::D1 as usize]
+        );
+        assert!(raw[Term::D2 as usize] < 1e-9);
+        // XOR = 2 * (area - overlap); compare with a per-pixel count.
+        let brute = (0..96)
+            .flat_map(|y| (0..128).map(move |x| (x, y)))
+            .filter(|&(x, y)| t.get(x, y) != s.get(x, y))
+            .count();
+        assert_eq!(raw[Term::Xor as usize], brute as f64);
+    }
+
+    #[test]
+    fn boundary_terms_follow_the_texts_intent() {
+        // A 20x20 square target in a 64x64 image. Inner band = outline pixels 2 deep
+        // inside; outer band = 2 deep outside.
+        let target = Mask::from_fn(64, 64, |x, y| {
+            (20..40).contains(&x) && (20..40).contains(&y)
+        });
+        let td = TargetData::new(&target);
+        assert_eq!(td.inner.count(), 20 * 20 - 16 * 16);
+        assert_eq!(td.outer.count(), 24 * 24 - 20 * 20);
+        // A shadow equal to the target: no inner pixel left uncovered, no outer pixel covered.
+        let raw = terms(&target, &target);
+        assert_eq!(raw[Term::Inner as usize], 0.0);
+        assert_eq!(raw[Term::Outer as usize], 0.0);
+        // An empty shadow leaves the whole inner band uncovered and covers nothing outside.
+        let empty = Mask::new(64, 64);
+        let raw = terms(&target, &empty);
+        assert_eq!(raw[Term::Inner as usize], td.inner.count() as f64);
+        assert_eq!(raw[Term::Outer as usize], 0.0);
+        // A shadow one pixel larger on every side covers one ring of the outer band.
+        let big = Mask::from_fn(64, 64, |x, y| {
+            (19..41).contains(&x) && (19..41).contains(&y)
+        });
+        let raw = terms(&target, &big);
+        assert_eq!(raw[Term::Inner as usize], 0.0);
+        assert_eq!(raw[Term::Outer as usize], (22 * 22 - 20 * 20) as f64);
+    }
+
+    #[test]
+    fn empty_shadow_gets_finite_fallbacks() {
+        let t = disc(64, 48, 30.0, 20.0, 10.0);
+        let raw = terms(&t, &Mask::new(64, 48));
+        assert_eq!(raw[Term::D0 as usize], t.count() as f64);
+        assert!((raw[Term::D1 as usize] - (64f64.hypot(48.0))).abs() < 1e-12);
+        assert!(raw[Term::D2 as usize] > 0.0 && raw[Term::D2 as usize].is_finite());
+    }
+
+    #[test]
+    fn barrier_and_hint_fallbacks() {
+        let td = TargetData::new(&disc(640, 480, 320.0, 240.0, 50.0));
+        assert_eq!(td.barrier(Some(DVec2::new(320.0, 240.0 + 239.0))), 0.0);
+        assert!((td.barrier(Some(DVec2::new(320.0, 240.0 + 300.0))) - 300.0).abs() < 1e-12);
+        assert_eq!(td.barrier(None), 8000.0);
+        assert_eq!(
+            td.hint_distance(Some(DVec2::new(3.0, 4.0)), DVec2::ZERO),
+            5.0
+        );
+        assert_eq!(
+            td.hint_distance(Some(DVec2::new(f64::NAN, 4.0)), DVec2::ZERO),
+            8000.0
+        );
+    }
+
+    #[test]
+    fn weighted_total_never_returns_nan() {
+        let mut raw = [1.0; TERM_COUNT];
+        let w = Weights::all_ones();
+        assert_eq!(weighted_total(&raw, &w), 10.0);
+        raw[3] = f64::NAN;
+        assert_eq!(weighted_total(&raw, &w), DIVERGED_ENERGY);
+    }
+
+    #[test]
+    fn iou_basics() {
+        let a = Mask::from_fn(64, 1, |x, _| x < 32);
+        let b = Mask::from_fn(64, 1, |x, _| x >= 16);
+        assert!((iou(&a, &b) - 16.0 / 64.0).abs() < 1e-12);
+        assert_eq!(iou(&Mask::new(8, 8), &Mask::new(8, 8)), 1.0);
+    }
+}

@@ -1,0 +1,455 @@
+//! One sample: launch velocities in, energy out.
+//!
+//! Main types: [`Problem`] (a [`Scene`] plus everything derived from it once: target
+//! boundary masks and moments, contact shapes), [`Workspace`] (per-worker buffers, so
+//! that evaluating a sample allocates nothing), [`Outcome`] (what the flight did) and
+//! [`Evaluation`] (the ten raw terms, the weighted total, IoU).
+//!
+//! Data flow of [`Problem::evaluate`]:
+//! 1. exact free flight of every launched body from its launch pose ([`FreeFlight`]);
+//! 2. first contact between bodies, or of a launched body with the table, before `t`
+//!    ([`crate::contact`]) gives `t_sim` and `n_contact`;
+//! 3. poses at `t`: the bodies carry on by free flight after the stop (the contact only
+//!    costs its penalty), and a body that lands stays on the table (its vertical motion
+//!    is absorbed, its horizontal motion and spin go on), so it is never lost under it;
+//! 4. the exact shadow at `t` into a bit mask ([`crate::raster`]);
+//! 5. the energy terms ([`crate::energy`]).
+//!
+//! Taking the shadow at `t` rather than at the stop matters: the field notes record that
+//! CMA-ES otherwise learns to collide within milliseconds and freeze a good picture.
+//!
+//! The numeric core does not fail: non-finite launch values or a diverged flight give
+//! [`DIVERGED_ENERGY`], never an error.
+
+use glam::{DQuat, DVec3};
+
+use crate::body::{FlightConfig, FreeFlight, Shape};
+use crate::contact::{self, Body, ContactShape, Motion};
+use crate::energy::{self, TargetData, Term, Weights, DIVERGED_ENERGY, REG_ALPHA, TERM_COUNT};
+use crate::mask::Mask;
+use crate::raster::RasterScratch;
+use crate::scene::Scene;
+
+/// Contacts closer together in time than this (s) are counted as one event's contacts.
+const SIMULTANEOUS: f64 = 1e-6;
+
+/// A scene plus everything the hot loop derives from it once.
+pub struct Problem {
+    pub scene: Scene,
+    pub target: TargetData,
+    pub shapes: Vec<ContactShape>,
+    table_shape: Option<ContactShape>,
+    /// Whether each mesh is closed and outward-oriented (enables back-face culling).
+    closed: Vec<bool>,
+    pub flight: FlightConfig,
+}
+
+/// Per-worker reusable buffers.
+pub struct Workspace {
+    flights: Vec<FreeFlight>,
+    pub mask: Mask,
+    raster: RasterScratch,
+    world_vertices: Vec<DVec3>,
+    /// Pose of every occluder at `t` (body origin, orientation), from the last sample.
+    pub poses: Vec<(DVec3, DQuat)>,
+    landing: Vec<Option<f64>>,
+}
+
+/// What happened in flight.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Outcome {
+    /// Time at which the simulation stopped (= `t` without contact).
+    pub t_sim: f64,
+    /// Number of contacts at the stop (0 without contact).
+    pub n_contacts: u32,
+    /// The first contact's participants: (occluder, other occluder or `None` for the table).
+    pub first_contact: Option<(usize, Option<usize>)>,
+}
+
+/// The energy of one sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Evaluation {
+    /// Unweighted value of every term (0 for terms that were skipped by weight 0).
+    pub raw: [f64; TERM_COUNT],
+    /// Weighted total with the weights it was evaluated with.
+    pub total: f64,
+    pub outcome: Outcome,
+    /// Intersection over union of the shadow at `t` and the target.
+    pub iou: f64,
+}
+
+impl Evaluation {
+    fn diverged() -> Evaluation {
+        Evaluation {
+            raw: [f64::NAN; TERM_COUNT],
+            total: DIVERGED_ENERGY,
+            outcome: Outcome {
+                t_sim: 0.0,
+                n_contacts: 0,
+                first_contact: None,
+            },
+            iou: 0.0,
+        }
+    }
+
+    /// Weighted value of each term.
+    pub fn weighted(&self, w: &Weights) -> [f64; TERM_COUNT] {
+        let mut out = [0.0; TERM_COUNT];
+        for ((o, r), w) in out.iter_mut().zip(&self.raw).zip(&w.0) {
+            // A skipped term (weight 0) may hold NaN from a diverged sample; it weighs nothing.
+            *o = if *w == 0.0 { 0.0 } else { r * w };
+        }
+        out
+    }
+}
+
+/// Launch velocities of one occluder, read from a parameter vector.
+pub fn launch_velocities(params: &[f64], i: usize) -> (DVec3, DVec3) {
+    let p = &params[6 * i..6 * i + 6];
+    (DVec3::new(p[0], p[1], p[2]), DVec3::new(p[3], p[4], p[5]))
+}
+
+impl Problem {
+    pub fn new(scene: Scene) -> Problem {
+        let target = TargetData::new(&scene.target);
+        let shapes = scene
+            .occluders
+            .iter()
+            .map(|o| ContactShape::new(&o.shape))
+            .collect();
+        let closed = scene
+            .occluders
+            .iter()
+            .map(|o| match &o.shape {
+                Shape::Mesh(m) => m.is_closed_and_oriented() && m.signed_volume() > 0.0,
+                _ => true,
+            })
+            .collect();
+        let table_shape = scene.table.as_ref().map(contact::table_shape);
+        Problem {
+            scene,
+            target,
+            shapes,
+            table_shape,
+            closed,
+            flight: FlightConfig::default(),
+        }
+    }
+
+    /// A fresh workspace for one worker thread.
+    pub fn workspace(&self) -> Workspace {
+        let n = self.scene.occluders.len();
+        let max_vertices = self
+            .scene
+            .occluders
+            .iter()
+            .map(|o| match &o.shape {
+                Shape::Mesh(m) => m.vertices.len(),
+                _ => 8,
+            })
+            .max()
+            .unwrap_or(8);
+        Workspace {
+            flights: (0..n).map(|_| FreeFlight::default()).collect(),
+            mask: Mask::new(self.scene.target.width(), self.scene.target.height()),
+            raster: RasterScratch::default(),
+            world_vertices: Vec::with_capacity(max_vertices),
+            poses: vec![(DVec3::ZERO, DQuat::IDENTITY); n],
+            landing: vec![None; n],
+        }
+    }
+
+    /// Evaluate one sample. `params` holds 6 values per occluder (`v` then `w`); values of
+    /// non-launched occluders are ignored. Terms with weight 0 are skipped.
+    pub fn evaluate(&self, params: &[f64], weights: &Weights, ws: &mut Workspace) -> Evaluation {
+        debug_assert_eq!(params.len(), self.scene.variable_count());
+        if params.iter().any(|x| !x.is_finite()) {
+            return Evaluation::diverged();
+        }
+        let outcome = self.fly(params, ws);
+        self.shadow(ws);
+        let mut raw = [0.0; TERM_COUNT];
+        energy::image_terms(&self.target, &ws.mask, weights, &mut raw);
+        self.physics_and_scene_terms(params, &outcome, ws, &mut raw);
+        let total = energy::weighted_total(&raw, weights);
+        let iou = energy::iou(&ws.mask, &self.target.mask);
+        Evaluation {
+            raw,
+            total,
+            outcome,
+            iou,
+        }
+    }
+
+    /// Steps 1-3: flights, first contact, poses at `t` (into `ws.poses`).
+    pub fn fly(&self, params: &[f64], ws: &mut Workspace) -> Outcome {
+        let scene = &self.scene;
+        let t = scene.t;
+        for (i, o) in scene.occluders.iter().enumerate() {
+            if o.launched {
+                let (v, w) = launch_velocities(params, i);
+                ws.flights[i].reset(
+                    &o.mass,
+                    o.position,
+                    o.orientation,
+                    v,
+                    w,
+                    scene.gravity,
+                    t,
+                    &self.flight,
+                );
+            }
+        }
+        let outcome = self.first_contact(ws);
+        for (i, o) in scene.occluders.iter().enumerate() {
+            ws.poses[i] = if !o.launched {
+                (o.position, o.orientation)
+            } else {
+                let f = &ws.flights[i];
+                let q = f.orientation(t);
+                let com = match ws.landing[i] {
+                    // Landed before t: the table absorbs the vertical motion; the body
+                    // slides on with its horizontal velocity from the landing.
+                    Some(tl) if tl < t => {
+                        let mut vh = f.com_velocity(tl);
+                        vh.z = 0.0;
+                        f.com(tl) + vh * (t - tl)
+                    }
+                    _ => f.com(t),
+                };
+                (com - q * o.mass.local_com, q)
+            };
+        }
+        outcome
+    }
+
+    fn motion<'a>(&self, i: usize, ws: &'a Workspace) -> Motion<'a> {
+        let o = &self.scene.occluders[i];
+        if o.launched {
+            Motion::Flying(&ws.flights[i])
+        } else {
+            Motion::Fixed {
+                origin: o.position,
+                orientation: o.orientation,
+                com: o.launch_com(),
+            }
+        }
+    }
+
+    fn first_contact(&self, ws: &mut Workspace) -> Outcome {
+        let scene = &self.scene;
+        let t = scene.t;
+        let n = scene.occluders.len();
+        let mut best = f64::INFINITY;
+        let mut first = None;
+        // Landings are needed for every body (they decide its pose at t), so they are
+        // searched over the whole flight.
+        for i in 0..n {
+            ws.landing[i] = None;
+            if !scene.occluders[i].launched {
+                continue;
+            }
+            if let (Some(table), Some(ts)) = (&scene.table, &self.table_shape) {
+                let body = Body {
+                    motion: self.motion(i, ws),
+                    shape: &self.shapes[i],
+                    radius: scene.occluders[i].bounding_radius,
+                };
+                let tl = contact::table_contact_time(&body, table, ts, t);
+                ws.landing[i] = tl;
+                if let Some(tl) = tl {
+                    if tl < best {
+                        best = tl;
+                        first = Some((i, None));
+                    }
+                }
+            }
+        }
+        let mut pair_times = 0u32;
+        let mut pair_hits: [f64; 64] = [f64::INFINITY; 64];
+        for i in 0..n {
+            for j in (i + 1)..n {
+                if !scene.occluders[i].launched && !scene.occluders[j].launched {
+                    continue;
+                }
+                // Only contacts before the best so far (plus the simultaneity window)
+                // can change the outcome, so later ones are not searched for.
+                let horizon = t.min(best + SIMULTANEOUS);
+                let a = Body {
+                    motion: self.motion(i, ws),
+                    shape: &self.shapes[i],
+                    radius: scene.occluders[i].bounding_radius,
+                };
+                let b = Body {
+                    motion: self.motion(j, ws),
+                    shape: &self.shapes[j],
+                    radius: scene.occluders[j].bounding_radius,
+                };
+                if let Some(tc) = contact::pair_contact_time(&a, &b, horizon) {
+                    if (pair_times as usize) < pair_hits.len() {
+                        pair_hits[pair_times as usize] = tc;
+                    }
+                    pair_times += 1;
+                    if tc < best {
+                        best = tc;
+                        first = Some((i, Some(j)));
+                    }
+                }
+            }
+        }
+        if best >= t {
+            return Outcome {
+                t_sim: t,
+                n_contacts: 0,
+                first_contact: None,
+            };
+        }
+        let cut = best + SIMULTANEOUS;
+        let mut count = ws.landing.iter().flatten().filter(|&&tl| tl <= cut).count() as u32;
+        count += pair_hits.iter().filter(|&&tc| tc <= cut).count() as u32;
+        // More than 64 pair hits within one horizon is not realistic; count the overflow
+        // as simultaneous, which only raises the penalty.
+        count += pair_times.saturating_sub(pair_hits.len() as u32);
+        Outcome {
+            t_sim: best,
+            n_contacts: count.max(1),
+            first_contact: first,
+        }
+    }
+
+    /// Step 4: the shadow of every occluder at its pose in `ws.poses`, into `ws.mask`.
+    pub fn shadow(&self, ws: &mut Workspace) {
+        let cam = &self.scene.camera;
+        ws.mask.clear();
+        for (i, o) in self.scene.occluders.iter().enumerate() {
+            let (p, q) = ws.poses[i];
+            match &o.shape {
+                Shape::Sphere { radius } => cam.rasterize_sphere(p, *radius, &mut ws.mask),
+                Shape::Cuboid { half_extents } => {
+                    cam.rasterize_box(p, q, *half_extents, &mut ws.mask, &mut ws.raster)
+                }
+                Shape::Mesh(mesh) => {
+                    ws.world_vertices.clear();
+                    ws.world_vertices
+                        .extend(mesh.vertices.iter().map(|v| p + q * *v));
+                    cam.rasterize_triangles(
+                        &ws.world_vertices,
+                        &mesh.triangles,
+                        self.closed[i],
+                        &mut ws.mask,
+                        &mut ws.raster,
+                    );
+                }
+            }
+        }
+    }
+
+    fn physics_and_scene_terms(
+        &self,
+        params: &[f64],
+        outcome: &Outcome,
+        ws: &Workspace,
+        raw: &mut [f64; TERM_COUNT],
+    ) {
+        let scene = &self.scene;
+        raw[Term::Contact as usize] = (scene.t - outcome.t_sim) * outcome.n_contacts as f64;
+        let mut reg = 0.0;
+        for (i, o) in scene.occluders.iter().enumerate() {
+            if o.launched {
+                let (v, w) = launch_velocities(params, i);
+                reg += REG_ALPHA * v.length() + (1.0 - REG_ALPHA) * w.length();
+            }
+        }
+        raw[Term::Reg as usize] = reg;
+        let cam = &scene.camera;
+        let mut hint = 0.0;
+        for h in &scene.hints {
+            let (p, q) = ws.poses[h.occluder];
+            let world = p + q * h.point;
+            hint += h.weight * self.target.hint_distance(cam.project(world), h.pixel);
+        }
+        raw[Term::Hint as usize] = hint;
+        let mut barrier = 0.0;
+        for (i, o) in scene.occluders.iter().enumerate() {
+            let (p, q) = ws.poses[i];
+            barrier += self.target.barrier(cam.project(p + q * o.mass.local_com));
+        }
+        raw[Term::Barrier as usize] = barrier;
+    }
+
+    /// Full parameter vector from a stage's varying subset.
+    pub fn expand(&self, base: &[f64], vary: &[usize], x: &[f64], out: &mut [f64]) {
+        out.copy_from_slice(base);
+        for (k, &i) in vary.iter().enumerate() {
+            out[6 * i..6 * i + 6].copy_from_slice(&x[6 * k..6 * k + 6]);
+        }
+    }
+
+    /// Time each phase of one sample, averaged over `reps` repetitions on this thread
+    /// (microseconds). Used for the per-term timings in `solution.json`.
+    pub fn profile(&self, params: &[f64], reps: usize, ws: &mut Workspace) -> Vec<(String, f64)> {
+        use std::time::Instant;
+        let reps = reps.max(1);
+        let all = Weights::all_ones();
+        let mut out: Vec<(String, f64)> = Vec::new();
+        let time = |f: &mut dyn FnMut()| {
+            let start = Instant::now();
+            for _ in 0..reps {
+                f();
+            }
+            start.elapsed().as_secs_f64() * 1e6 / reps as f64
+        };
+        let scene = &self.scene;
+        let us = time(&mut || {
+            for (i, o) in scene.occluders.iter().enumerate() {
+                if o.launched {
+                    let (v, w) = launch_velocities(params, i);
+                    ws.flights[i].reset(
+                        &o.mass,
+                        o.position,
+                        o.orientation,
+                        v,
+                        w,
+                        scene.gravity,
+                        scene.t,
+                        &self.flight,
+                    );
+                }
+            }
+        });
+        out.push(("flight".into(), us));
+        let us = time(&mut || {
+            std::hint::black_box(self.first_contact(ws));
+        });
+        out.push(("contacts".into(), us));
+        self.fly(params, ws);
+        let us = time(&mut || self.shadow(ws));
+        out.push(("shadow".into(), us));
+        let m = ws.mask.clone();
+        for term in [
+            Term::D0,
+            Term::D1,
+            Term::D2,
+            Term::Xor,
+            Term::Inner,
+            Term::Outer,
+        ] {
+            let mut w = Weights::default();
+            w.0[term as usize] = 1.0;
+            let mut raw = [0.0; TERM_COUNT];
+            let us = time(&mut || {
+                energy::image_terms(&self.target, std::hint::black_box(&m), &w, &mut raw)
+            });
+            out.push((term.key().into(), us));
+        }
+        let outcome = self.fly(params, ws);
+        let mut raw = [0.0; TERM_COUNT];
+        let us = time(&mut || self.physics_and_scene_terms(params, &outcome, ws, &mut raw));
+        out.push(("contact+reg+hint+barrier".into(), us));
+        let us = time(&mut || {
+            std::hint::black_box(self.evaluate(params, &all, ws));
+        });
+        out.push(("sample (all terms)".into(), us));
+        out
+    }
+}

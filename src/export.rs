@@ -1,0 +1,216 @@
+//! Writing results: `solution.json`, `shadow.png`, `overlay.png`, `preview.png`,
+//! `convergence.csv` and `convergence.png` in an output folder.
+//!
+//! Main functions: [`write_solution`], [`read_solution`], [`write_pictures`],
+//! [`write_convergence`], [`read_convergence`]. Every file is written atomically
+//! (a temporary file in the same folder, then a rename), so an interrupted run never
+//! leaves a half-written file behind.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::energy::{Term, TERM_COUNT};
+use crate::mask::Mask;
+use crate::picture;
+use crate::solver::{SampleRecord, Solution};
+
+/// Why an output could not be written or read.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    #[error("cannot write {path}: {source}")]
+    Write {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("cannot read {path}: {source}")]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{path} is not a valid solution file: {message}")]
+    BadSolution { path: PathBuf, message: String },
+    #[error("{path} is not a valid convergence table: {message}")]
+    BadConvergence { path: PathBuf, message: String },
+    #[error("cannot encode {path}: {message}")]
+    Encode { path: PathBuf, message: String },
+}
+
+type Result<T> = std::result::Result<T, ExportError>;
+
+/// Write `bytes` to `path` atomically.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let err = |source| ExportError::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    if let Some(dir) = path.parent() {
+        if !dir.as_os_str().is_empty() {
+            std::fs::create_dir_all(dir).map_err(err)?;
+        }
+    }
+    let name = path.file_name().and_then(|s| s.to_str()).unwrap_or("out");
+    let tmp = path.with_file_name(format!(".{name}.tmp{}", std::process::id()));
+    let mut f = std::fs::File::create(&tmp).map_err(err)?;
+    f.write_all(bytes).map_err(err)?;
+    f.sync_all().map_err(err)?;
+    drop(f);
+    std::fs::rename(&tmp, path).map_err(err)
+}
+
+fn png_bytes<P, C>(img: &image::ImageBuffer<P, C>, path: &Path) -> Result<Vec<u8>>
+where
+    P: image::Pixel<Subpixel = u8> + image::PixelWithColorType,
+    C: std::ops::Deref<Target = [u8]>,
+{
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    use image::ImageEncoder;
+    let mut out = Vec::new();
+    // Fast compression: these are previews written while the optimizer runs.
+    PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive)
+        .write_image(img.as_raw(), img.width(), img.height(), P::COLOR_TYPE)
+        .map_err(|e| ExportError::Encode {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+    Ok(out)
+}
+
+/// Write an image as PNG, atomically.
+pub fn save_png<P, C>(img: &image::ImageBuffer<P, C>, path: &Path) -> Result<()>
+where
+    P: image::Pixel<Subpixel = u8> + image::PixelWithColorType,
+    C: std::ops::Deref<Target = [u8]>,
+{
+    write_atomic(path, &png_bytes(img, path)?)
+}
+
+/// `solution.json`.
+pub fn write_solution(dir: &Path, s: &Solution) -> Result<()> {
+    let path = dir.join("solution.json");
+    let text = serde_json::to_string_pretty(s).map_err(|e| ExportError::Encode {
+        path: path.clone(),
+        message: e.to_string(),
+    })?;
+    write_atomic(&path, text.as_bytes())
+}
+
+/// Read a solution file.
+pub fn read_solution(path: &Path) -> Result<Solution> {
+    let text = std::fs::read_to_string(path).map_err(|source| ExportError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    serde_json::from_str(&text).map_err(|e| ExportError::BadSolution {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
+}
+
+/// The overlay of a shadow on the target (target black, shadow translucent red).
+pub fn overlay(target: &Mask, shadow: &Mask) -> image::RgbImage {
+    picture::overlay_image(
+        target.width(),
+        target.height(),
+        &|x, y| target.get(x, y),
+        &|x, y| shadow.get(x, y),
+    )
+}
+
+/// `shadow.png` (the mask at t) and `overlay.png`.
+pub fn write_pictures(dir: &Path, target: &Mask, shadow: &Mask) -> Result<()> {
+    let img = picture::mask_image(shadow.width(), shadow.height(), &|x, y| shadow.get(x, y));
+    save_png(&img, &dir.join("shadow.png"))?;
+    save_png(&overlay(target, shadow), &dir.join("overlay.png"))
+}
+
+/// `preview.png`: the overlay of the best shadow so far.
+pub fn write_preview(dir: &Path, target: &Mask, shadow: &Mask) -> Result<()> {
+    save_png(&overlay(target, shadow), &dir.join("preview.png"))
+}
+
+/// `convergence.csv` (every sample: stage, iteration, each weighted term, total) and
+/// `convergence.png` (one log-scale panel per stage).
+pub fn write_convergence(
+    dir: &Path,
+    stage_names: &[String],
+    records: &[SampleRecord],
+) -> Result<()> {
+    let path = dir.join("convergence.csv");
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header = vec!["stage".to_string(), "iteration".to_string()];
+    header.extend(Term::ALL.iter().map(|t| t.key().to_string()));
+    header.push("total".into());
+    let enc = |e: csv::Error| ExportError::Encode {
+        path: path.clone(),
+        message: e.to_string(),
+    };
+    w.write_record(&header).map_err(enc)?;
+    for r in records {
+        let mut row = vec![r.stage.to_string(), r.iteration.to_string()];
+        row.extend(r.terms.iter().map(|x| format!("{x:e}")));
+        row.push(format!("{:e}", r.total));
+        w.write_record(&row).map_err(enc)?;
+    }
+    let bytes = w.into_inner().map_err(|e| ExportError::Encode {
+        path: path.clone(),
+        message: e.to_string(),
+    })?;
+    write_atomic(&path, &bytes)?;
+    let data = picture::ConvergenceData {
+        stage_names: stage_names.to_vec(),
+        term_names: Term::ALL.iter().map(|t| t.label().to_string()).collect(),
+        rows: records
+            .iter()
+            .map(|r| picture::ConvergenceRow {
+                stage: r.stage,
+                iteration: r.iteration,
+                terms: r.terms.to_vec(),
+                total: r.total,
+            })
+            .collect(),
+    };
+    let img = picture::convergence_plot(&data, 520, 380);
+    save_png(&img, &dir.join("convergence.png"))
+}
+
+/// Read `convergence.csv` back (for `--resume`), keeping the rows of stages below `stages`.
+pub fn read_convergence(path: &Path, stages: usize) -> Result<Vec<SampleRecord>> {
+    let bad = |message: String| ExportError::BadConvergence {
+        path: path.to_path_buf(),
+        message,
+    };
+    let mut r = csv::Reader::from_path(path).map_err(|e| bad(e.to_string()))?;
+    let mut out = Vec::new();
+    for row in r.records() {
+        let row = row.map_err(|e| bad(e.to_string()))?;
+        if row.len() != TERM_COUNT + 3 {
+            return Err(bad(format!(
+                "a row has {} columns, expected {}",
+                row.len(),
+                TERM_COUNT + 3
+            )));
+        }
+        let num = |i: usize| -> Result<f64> {
+            row[i]
+                .parse::<f64>()
+                .map_err(|e| bad(format!("`{}`: {e}", &row[i])))
+        };
+        let stage = row[0].parse::<usize>().map_err(|e| bad(e.to_string()))?;
+        if stage >= stages {
+            continue;
+        }
+        let mut terms = [0.0; TERM_COUNT];
+        for (k, t) in terms.iter_mut().enumerate() {
+            *t = num(2 + k)?;
+        }
+        out.push(SampleRecord {
+            stage,
+            iteration: row[1].parse::<usize>().map_err(|e| bad(e.to_string()))?,
+            terms,
+            total: num(TERM_COUNT + 2)?,
+        });
+    }
+    Ok(out)
+}

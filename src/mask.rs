@@ -1,0 +1,858 @@
+//! Bit-packed binary images and the pixel statistics the energies need.
+//!
+//! [`Mask`] stores a `width` x `height` binary image as rows of `u64` words: bit `k` of
+//! word `w` in row `j` is pixel `x = 64 * w + k`, `y = j`. Bits past `width` in the last
+//! word of a row (the padding) are always zero, so whole-word operations such as
+//! `count_ones` never see garbage. Every mask also keeps a conservative range of rows that
+//! may hold set bits; rows outside it are guaranteed zero, which lets [`Mask::clear`] and
+//! the counting functions skip the empty part of a sparse shadow image.
+//!
+//! Data flow in the project: the rasterizer ([`crate::raster`]) fills a cleared mask with
+//! [`Mask::fill_span`]; the energies then compare it with the target through
+//! [`Mask::xor_count`], [`Mask::and_count`], [`Mask::and_not_count`] and
+//! [`Mask::moments`] (which returns [`Moments`]). The morphological operations
+//! [`Mask::erode`] and [`Mask::dilate`] run once per scene to build the target's
+//! boundary bands.
+//!
+//! Pixel convention for moments: pixel `(i, j)` is the unit square `[i, i+1] x [j, j+1]`
+//! and contributes at its centre `(i + 0.5, j + 0.5)`, in pixel units with `y` pointing
+//! down the image.
+
+use glam::DVec2;
+use std::fmt;
+use std::ops::Range;
+
+/// A binary image with bit-packed rows. See the module documentation for the layout.
+#[derive(Clone)]
+pub struct Mask {
+    width: usize,
+    height: usize,
+    words_per_row: usize,
+    words: Vec<u64>,
+    /// Rows `rows.start..rows.end` may hold set bits; all other rows are zero. The range
+    /// is conservative (it may include empty rows) and is `0..0` when nothing was set.
+    rows: Range<usize>,
+}
+
+/// Raw image moments of a mask in pixel units (pixel centres at `i + 0.5`, `j + 0.5`).
+///
+/// The sums are exact: they are accumulated in integers and converted at the end.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Moments {
+    /// M00: number of set pixels.
+    pub count: f64,
+    /// M10 = sum of x.
+    pub sum_x: f64,
+    /// M01 = sum of y.
+    pub sum_y: f64,
+    /// M20 = sum of x^2.
+    pub sum_xx: f64,
+    /// M11 = sum of x*y.
+    pub sum_xy: f64,
+    /// M02 = sum of y^2.
+    pub sum_yy: f64,
+}
+
+impl Moments {
+    /// The centroid (xbar, ybar) in pixels, or `None` for an empty mask.
+    pub fn centroid(&self) -> Option<DVec2> {
+        if self.count > 0.0 {
+            Some(DVec2::new(self.sum_x / self.count, self.sum_y / self.count))
+        } else {
+            None
+        }
+    }
+
+    /// Normalised central second moments `[mu20, mu11, mu02]` (pixels squared), where
+    /// `mu_pq = sum (x - xbar)^p (y - ybar)^q / M00`, or `None` for an empty mask.
+    pub fn central_second(&self) -> Option<[f64; 3]> {
+        let c = self.centroid()?;
+        let m = self.count;
+        Some([
+            self.sum_xx / m - c.x * c.x,
+            self.sum_xy / m - c.x * c.y,
+            self.sum_yy / m - c.y * c.y,
+        ])
+    }
+}
+
+/// `sum_{i=0}^{m-1} (2i+1)^2 = m (2m-1) (2m+1) / 3`, exact in integers. Moments are
+/// accumulated in doubled coordinates (`2x = 2i + 1`) so every run sum is an integer.
+#[inline]
+fn sum_odd_squares(m: u64) -> u64 {
+    // For m = 0 the middle factor wraps, but the product is still 0.
+    m.wrapping_mul((2 * m).wrapping_sub(1))
+        .wrapping_mul(2 * m + 1)
+        / 3
+}
+
+/// Word `w` of `row` shifted so that bit `x` of the result is bit `x + d` of the row
+/// (zero where `x + d` falls outside the row's words).
+#[inline]
+fn shifted_word(row: &[u64], w: usize, d: isize) -> u64 {
+    let q = d.div_euclid(64);
+    let s = d.rem_euclid(64) as u32;
+    let get = |i: isize| -> u64 {
+        if i >= 0 && (i as usize) < row.len() {
+            row[i as usize]
+        } else {
+            0
+        }
+    };
+    let base = w as isize + q;
+    let lo = get(base) >> s;
+    if s == 0 {
+        lo
+    } else {
+        lo | (get(base + 1) << (64 - s))
+    }
+}
+
+impl Mask {
+    /// An all-zero mask of `width` x `height` pixels.
+    pub fn new(width: usize, height: usize) -> Mask {
+        let words_per_row = width.div_ceil(64);
+        Mask {
+            width,
+            height,
+            words_per_row,
+            words: vec![0; words_per_row * height],
+            rows: 0..0,
+        }
+    }
+
+    /// A mask with pixel `(x, y)` set iff `f(x, y)`.
+    pub fn from_fn(width: usize, height: usize, mut f: impl FnMut(usize, usize) -> bool) -> Mask {
+        let mut m = Mask::new(width, height);
+        for y in 0..height {
+            for x in 0..width {
+                if f(x, y) {
+                    m.set(x, y);
+                }
+            }
+        }
+        m
+    }
+
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    pub fn words_per_row(&self) -> usize {
+        self.words_per_row
+    }
+
+    /// The rows that may hold set bits (all rows outside are zero). Conservative.
+    pub fn row_range(&self) -> Range<usize> {
+        self.rows.clone()
+    }
+
+    /// The words of row `j` (bit `k` of word `w` is pixel `64 * w + k`).
+    #[inline]
+    pub fn row(&self, j: usize) -> &[u64] {
+        &self.words[j * self.words_per_row..(j + 1) * self.words_per_row]
+    }
+
+    /// Mask with the valid (non-padding) bits of the last word of a row.
+    #[inline]
+    fn last_word_mask(&self) -> u64 {
+        match self.width % 64 {
+            0 => !0,
+            r => (1u64 << r) - 1,
+        }
+    }
+
+    /// Record that row `y` may now hold set bits.
+    #[inline(always)]
+    fn touch_row(&mut self, y: usize) {
+        if self.rows.start >= self.rows.end {
+            self.rows = y..y + 1;
+        } else {
+            self.rows.start = self.rows.start.min(y);
+            self.rows.end = self.rows.end.max(y + 1);
+        }
+    }
+
+    pub fn get(&self, x: usize, y: usize) -> bool {
+        assert!(
+            x < self.width && y < self.height,
+            "pixel ({x}, {y}) outside the mask"
+        );
+        (self.words[y * self.words_per_row + x / 64] >> (x % 64)) & 1 == 1
+    }
+
+    pub fn set(&mut self, x: usize, y: usize) {
+        assert!(
+            x < self.width && y < self.height,
+            "pixel ({x}, {y}) outside the mask"
+        );
+        self.words[y * self.words_per_row + x / 64] |= 1u64 << (x % 64);
+        self.touch_row(y);
+    }
+
+    /// Clear every pixel. Only the rows in the tracked range are written.
+    pub fn clear(&mut self) {
+        let r = self.rows.clone();
+        self.words[r.start * self.words_per_row..r.end * self.words_per_row].fill(0);
+        self.rows = 0..0;
+    }
+
+    /// Set every pixel (padding bits stay zero).
+    pub fn fill_all(&mut self) {
+        if self.width == 0 || self.height == 0 {
+            return;
+        }
+        self.words.fill(!0);
+        let last = self.last_word_mask();
+        let wpr = self.words_per_row;
+        for row in self.words.chunks_exact_mut(wpr) {
+            row[wpr - 1] = last;
+        }
+        self.rows = 0..self.height;
+    }
+
+    /// Set pixels `x0..=x1` of row `y` using whole-word masks. Empty if `x0 > x1`.
+    /// The caller clamps: `x1 < width` and `y < height` are required.
+    #[inline(always)]
+    pub fn fill_span(&mut self, y: usize, x0: usize, x1: usize) {
+        if x0 > x1 {
+            return;
+        }
+        assert!(x1 < self.width && y < self.height, "span outside the mask");
+        let base = y * self.words_per_row;
+        let (w0, w1) = (x0 / 64, x1 / 64);
+        let m0 = !0u64 << (x0 % 64);
+        let m1 = !0u64 >> (63 - x1 % 64);
+        let row = &mut self.words[base..base + self.words_per_row];
+        if w0 == w1 {
+            row[w0] |= m0 & m1;
+        } else if w1 == w0 + 1 {
+            row[w0] |= m0;
+            row[w1] |= m1;
+        } else {
+            // Spans are short, so OR-ing a per-word mask beats a `fill` of the middle
+            // words, which compiles to a call to `memset`.
+            for (k, word) in row[w0..=w1].iter_mut().enumerate() {
+                let mut m = !0u64;
+                if k == 0 {
+                    m &= m0;
+                }
+                if k == w1 - w0 {
+                    m &= m1;
+                }
+                *word |= m;
+            }
+        }
+        self.touch_row(y);
+    }
+
+    /// Number of set pixels.
+    pub fn count(&self) -> u64 {
+        let r = &self.rows;
+        self.words[r.start * self.words_per_row..r.end * self.words_per_row]
+            .iter()
+            .map(|w| w.count_ones() as u64)
+            .sum()
+    }
+
+    /// Union of the two masks' row ranges, as a word range into both word vectors.
+    fn union_words(&self, other: &Mask) -> Range<usize> {
+        assert!(
+            self.width == other.width && self.height == other.height,
+            "mask sizes differ: {}x{} vs {}x{}",
+            self.width,
+            self.height,
+            other.width,
+            other.height
+        );
+        let (a, b) = (&self.rows, &other.rows);
+        let r = if a.start >= a.end {
+            b.clone()
+        } else if b.start >= b.end {
+            a.clone()
+        } else {
+            a.start.min(b.start)..a.end.max(b.end)
+        };
+        r.start * self.words_per_row..r.end * self.words_per_row
+    }
+
+    /// Popcount of `op(a, b)` over a word range, with four independent accumulators so
+    /// the popcounts of consecutive words can overlap in the pipeline.
+    #[inline(always)]
+    fn pair_count(&self, other: &Mask, op: impl Fn(u64, u64) -> u64) -> u64 {
+        let r = self.union_words(other);
+        let a = &self.words[r.clone()];
+        let b = &other.words[r];
+        let mut acc = [0u64; 4];
+        let mut ca = a.chunks_exact(4);
+        let mut cb = b.chunks_exact(4);
+        for (x, y) in (&mut ca).zip(&mut cb) {
+            for k in 0..4 {
+                acc[k] += op(x[k], y[k]).count_ones() as u64;
+            }
+        }
+        let tail: u64 = ca
+            .remainder()
+            .iter()
+            .zip(cb.remainder())
+            .map(|(&x, &y)| op(x, y).count_ones() as u64)
+            .sum();
+        acc.iter().sum::<u64>() + tail
+    }
+
+    /// Number of pixels set in exactly one of the masks.
+    pub fn xor_count(&self, other: &Mask) -> u64 {
+        self.pair_count(other, |a, b| a ^ b)
+    }
+
+    /// Number of pixels set in both masks.
+    pub fn and_count(&self, other: &Mask) -> u64 {
+        self.pair_count(other, |a, b| a & b)
+    }
+
+    /// Number of pixels set in `self` but not in `other` (popcount of `self & !other`).
+    pub fn and_not_count(&self, other: &Mask) -> u64 {
+        self.pair_count(other, |a, b| a & !b)
+    }
+
+    /// `self & !other` as a new mask.
+    pub fn and_not(&self, other: &Mask) -> Mask {
+        assert!(
+            self.width == other.width && self.height == other.height,
+            "mask sizes differ"
+        );
+        let mut out = self.clone();
+        for (o, b) in out.words.iter_mut().zip(&other.words) {
+            *o &= !b;
+        }
+        out
+    }
+
+    /// `self |= other`.
+    pub fn or_assign(&mut self, other: &Mask) {
+        assert!(
+            self.width == other.width && self.height == other.height,
+            "mask sizes differ"
+        );
+        let r = other.rows.clone();
+        if r.start >= r.end {
+            return;
+        }
+        let wr = r.start * self.words_per_row..r.end * self.words_per_row;
+        for (o, b) in self.words[wr.clone()].iter_mut().zip(&other.words[wr]) {
+            *o |= b;
+        }
+        self.touch_row(r.start);
+        self.touch_row(r.end - 1);
+    }
+
+    /// Raw moments of the set pixels (pixel centres at `i + 0.5`, `j + 0.5`).
+    ///
+    /// Each word is decomposed into runs of consecutive set bits with `trailing_zeros`;
+    /// a run of pixels `a..b` contributes closed-form sums, so the cost depends on the
+    /// number of runs, not of pixels. Sums are kept in doubled coordinates as integers
+    /// (exact) and halved once at the end.
+    pub fn moments(&self) -> Moments {
+        let wpr = self.words_per_row;
+        // Totals in doubled coordinates: sum 1, sum 2x, sum 2y, sum 4x^2, sum 4xy, sum 4y^2.
+        let (mut n, mut sx2, mut sy2, mut sxx4, mut sxy4, mut syy4) =
+            (0u128, 0u128, 0u128, 0u128, 0u128, 0u128);
+        for j in self.rows.clone() {
+            let row = &self.words[j * wpr..(j + 1) * wpr];
+            // A run of pixels m0..m1 contributes F(m1) - F(m0) with
+            // F(m) = (m, m^2, G(m)) = (count, sum of 2x, sum of 4x^2 over pixels 0..m), so
+            // only the run boundaries matter. A boundary is a bit that differs from the
+            // pixel to its left: a start where the pixel is set, an end where it is clear.
+            // Words inside a run or inside a gap have no boundary bits and cost almost
+            // nothing; boundary bits are visited with trailing_zeros.
+            // Accumulated as (sum over ends) - (sum over starts) in wrapping u64, which
+            // is exact because the true per-row totals are non-negative and fit.
+            let (mut rn, mut rx2, mut rxx4) = (0u64, 0u64, 0u64);
+            let mut carry = 0u64; // the pixel left of the current word (0 outside)
+            for (w, &word) in row.iter().enumerate() {
+                let mut edges = word ^ ((word << 1) | carry);
+                carry = word >> 63;
+                let base = 64 * w as u64;
+                while edges != 0 {
+                    let p = edges.trailing_zeros();
+                    edges &= edges - 1;
+                    let m = base + p as u64;
+                    // All ones at a start (negate), zero at an end; branch-free so the
+                    // sums stay in registers.
+                    let neg = ((word >> p) & 1).wrapping_neg();
+                    let signed = |v: u64| (v ^ neg).wrapping_sub(neg);
+                    rn = rn.wrapping_add(signed(m));
+                    rx2 = rx2.wrapping_add(signed(m * m));
+                    rxx4 = rxx4.wrapping_add(signed(sum_odd_squares(m)));
+                }
+            }
+            if carry == 1 {
+                // A run reaching the end of the last word (width a multiple of 64).
+                let m = 64 * wpr as u64;
+                rn = rn.wrapping_add(m);
+                rx2 = rx2.wrapping_add(m * m);
+                rxx4 = rxx4.wrapping_add(sum_odd_squares(m));
+            }
+            if rn == 0 {
+                continue;
+            }
+            let yy = 2 * j as u128 + 1;
+            n += rn as u128;
+            sx2 += rx2 as u128;
+            sxx4 += rxx4 as u128;
+            sy2 += rn as u128 * yy;
+            sxy4 += rx2 as u128 * yy;
+            syy4 += rn as u128 * yy * yy;
+        }
+        Moments {
+            count: n as f64,
+            sum_x: sx2 as f64 / 2.0,
+            sum_y: sy2 as f64 / 2.0,
+            sum_xx: sxx4 as f64 / 4.0,
+            sum_xy: sxy4 as f64 / 4.0,
+            sum_yy: syy4 as f64 / 4.0,
+        }
+    }
+
+    /// Binary dilation with a `k` x `k` all-ones kernel centred on each pixel (`k` odd):
+    /// a pixel is set iff some pixel within Chebyshev distance `k / 2` is set. Pixels
+    /// outside the image count as 0.
+    pub fn dilate(&self, k: usize) -> Mask {
+        self.morph(k, false)
+    }
+
+    /// Binary erosion with a `k` x `k` all-ones kernel centred on each pixel (`k` odd):
+    /// a pixel stays set iff every pixel within Chebyshev distance `k / 2` is set.
+    /// Pixels outside the image count as 0, so everything within `k / 2` of the border
+    /// is cleared.
+    pub fn erode(&self, k: usize) -> Mask {
+        self.morph(k, true)
+    }
+
+    /// Separable morphology: a horizontal pass of word shifts, then a vertical pass over
+    /// whole rows. `erode` selects AND (erosion) instead of OR (dilation).
+    fn morph(&self, k: usize, erode: bool) -> Mask {
+        assert!(k % 2 == 1, "morphology kernel size must be odd, got {k}");
+        let r = k / 2;
+        let wpr = self.words_per_row;
+        let last = self.last_word_mask();
+        let combine = |a: u64, b: u64| if erode { a & b } else { a | b };
+
+        // Horizontal pass: row j of `horiz` combines the row shifted by -r..=r pixels.
+        // Zeros shifted in from beyond either edge (and the zero padding) implement
+        // "outside counts as 0".
+        let mut horiz = Mask::new(self.width, self.height);
+        horiz.rows = self.rows.clone();
+        for j in self.rows.clone() {
+            let src = self.row(j);
+            let dst = &mut horiz.words[j * wpr..(j + 1) * wpr];
+            for (w, out) in dst.iter_mut().enumerate() {
+                let mut acc = shifted_word(src, w, -(r as isize));
+                for d in -(r as isize) + 1..=r as isize {
+                    acc = combine(acc, shifted_word(src, w, d));
+                }
+                *out = acc;
+            }
+            if wpr > 0 {
+                dst[wpr - 1] &= last;
+            }
+        }
+
+        // Vertical pass: row j combines rows j-r..=j+r of `horiz`. For erosion rows
+        // outside the image are 0, so rows within r of the top or bottom become empty.
+        let mut out = Mask::new(self.width, self.height);
+        if self.rows.start >= self.rows.end {
+            return out;
+        }
+        let (lo, hi) = if erode {
+            (
+                self.rows.start.max(r),
+                self.rows.end.min(self.height.saturating_sub(r)),
+            )
+        } else {
+            (
+                self.rows.start.saturating_sub(r),
+                (self.rows.end + r).min(self.height),
+            )
+        };
+        if lo >= hi {
+            return out;
+        }
+        for j in lo..hi {
+            let (a, b) = (j.saturating_sub(r), (j + r).min(self.height - 1));
+            let dst = &mut out.words[j * wpr..(j + 1) * wpr];
+            dst.copy_from_slice(horiz.row(a));
+            for jj in a + 1..=b {
+                for (o, &s) in dst.iter_mut().zip(horiz.row(jj)) {
+                    *o = combine(*o, s);
+                }
+            }
+        }
+        out.rows = lo..hi;
+        out
+    }
+}
+
+impl PartialEq for Mask {
+    /// Pixel-wise equality; the tracked row ranges do not matter.
+    fn eq(&self, other: &Mask) -> bool {
+        self.width == other.width && self.height == other.height && self.words == other.words
+    }
+}
+
+impl Eq for Mask {}
+
+impl fmt::Debug for Mask {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Mask")
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .field("rows", &self.rows)
+            .field("count", &self.count())
+            .finish()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Small deterministic generator (SplitMix64) so the tests need no dependencies.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> u64 {
+            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = self.0;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^ (z >> 31)
+        }
+        fn below(&mut self, n: usize) -> usize {
+            (self.next() % n as u64) as usize
+        }
+    }
+
+    /// A random mask of blobs and noise, with some empty rows at top and bottom.
+    fn random_mask(rng: &mut Rng, w: usize, h: usize, density: u64) -> Mask {
+        let (top, bottom) = (rng.below(h / 3 + 1), h - rng.below(h / 3 + 1));
+        Mask::from_fn(w, h, |_, y| {
+            y >= top && y < bottom && rng.next() % 100 < density
+        })
+    }
+
+    fn padding_is_zero(m: &Mask) -> bool {
+        (0..m.height()).all(|j| m.row(j)[m.words_per_row() - 1] & !m.last_word_mask() == 0)
+    }
+
+    #[test]
+    fn fill_span_matches_per_bit_reference_across_word_boundaries() {
+        let w = 200;
+        let spans = [
+            (0, 0),
+            (0, 63),
+            (63, 64),
+            (1, 62),
+            (60, 130),
+            (64, 127),
+            (64, 128),
+            (5, 199),
+            (0, 199),
+            (127, 191),
+            (199, 199),
+            (10, 9),
+        ];
+        for &(x0, x1) in &spans {
+            let mut m = Mask::new(w, 3);
+            m.fill_span(1, x0, x1);
+            for x in 0..w {
+                assert_eq!(
+                    m.get(x, 1),
+                    x >= x0 && x <= x1,
+                    "span {x0}..={x1}, pixel {x}"
+                );
+                assert!(!m.get(x, 0) && !m.get(x, 2));
+            }
+            assert!(padding_is_zero(&m));
+            let expect = if x1 >= x0 { (x1 - x0 + 1) as u64 } else { 0 };
+            assert_eq!(m.count(), expect);
+        }
+    }
+
+    #[test]
+    fn set_get_clear_and_row_range() {
+        let mut m = Mask::new(70, 10);
+        assert_eq!(m.row_range(), 0..0);
+        m.set(69, 7);
+        m.set(0, 3);
+        assert!(m.get(69, 7) && m.get(0, 3) && !m.get(68, 7));
+        assert_eq!(m.row_range(), 3..8);
+        assert_eq!(m.count(), 2);
+        m.clear();
+        assert_eq!(m.count(), 0);
+        assert_eq!(m, Mask::new(70, 10));
+        assert_eq!(m.row_range(), 0..0);
+        m.fill_all();
+        assert_eq!(m.count(), 700);
+        assert!(padding_is_zero(&m));
+        m.clear();
+        assert_eq!(m, Mask::new(70, 10));
+    }
+
+    #[test]
+    fn equality_ignores_row_ranges() {
+        let mut a = Mask::new(10, 10);
+        a.set(3, 3);
+        a.set(4, 8);
+        let b = Mask::from_fn(10, 10, |x, y| (x, y) == (3, 3) || (x, y) == (4, 8));
+        assert_eq!(a, b);
+        let c = Mask::from_fn(10, 10, |x, y| (x, y) == (3, 3));
+        assert_ne!(a, c);
+    }
+
+    #[test]
+    fn pair_counts_match_per_pixel_reference() {
+        let mut rng = Rng(1);
+        for &(w, h) in &[(1, 1), (64, 5), (65, 7), (200, 31), (640, 48)] {
+            for _ in 0..5 {
+                let a = random_mask(&mut rng, w, h, 40);
+                let b = random_mask(&mut rng, w, h, 60);
+                let (mut x, mut n, mut an, mut ca) = (0, 0, 0, 0);
+                for y in 0..h {
+                    for i in 0..w {
+                        let (p, q) = (a.get(i, y), b.get(i, y));
+                        x += (p != q) as u64;
+                        n += (p && q) as u64;
+                        an += (p && !q) as u64;
+                        ca += p as u64;
+                    }
+                }
+                assert_eq!(a.xor_count(&b), x);
+                assert_eq!(a.and_count(&b), n);
+                assert_eq!(a.and_not_count(&b), an);
+                assert_eq!(a.count(), ca);
+                let d = a.and_not(&b);
+                assert_eq!(d.count(), an);
+                assert_eq!(d, Mask::from_fn(w, h, |i, y| a.get(i, y) && !b.get(i, y)));
+                let mut o = a.clone();
+                o.or_assign(&b);
+                assert_eq!(o, Mask::from_fn(w, h, |i, y| a.get(i, y) || b.get(i, y)));
+                assert_eq!(o.count(), ca + b.count() - n);
+            }
+        }
+        // One empty operand: the union of row ranges must still cover the other mask.
+        let e = Mask::new(100, 20);
+        let f = Mask::from_fn(100, 20, |x, y| x == y);
+        assert_eq!(e.xor_count(&f), 20);
+        assert_eq!(f.xor_count(&e), 20);
+        assert_eq!(e.and_not_count(&f), 0);
+        assert_eq!(f.and_not_count(&e), 20);
+    }
+
+    #[test]
+    fn moments_of_hand_made_masks() {
+        // A single pixel: centre (3.5, 5.5), no spread.
+        let mut m = Mask::new(10, 10);
+        m.set(3, 5);
+        let mo = m.moments();
+        assert_eq!(mo.count, 1.0);
+        assert_eq!(mo.centroid(), Some(DVec2::new(3.5, 5.5)));
+        assert_eq!(mo.sum_xx, 3.5 * 3.5);
+        assert_eq!(mo.sum_xy, 3.5 * 5.5);
+        assert_eq!(mo.central_second(), Some([0.0, 0.0, 0.0]));
+
+        // An a x b rectangle spanning word boundaries: mu20 = (a^2 - 1) / 12.
+        let (x0, x1, y0, y1) = (50usize, 149usize, 7usize, 26usize);
+        let r = Mask::from_fn(200, 40, |x, y| {
+            (x0..=x1).contains(&x) && (y0..=y1).contains(&y)
+        });
+        let mo = r.moments();
+        let (a, b) = ((x1 - x0 + 1) as f64, (y1 - y0 + 1) as f64);
+        assert_eq!(mo.count, a * b);
+        let c = mo.centroid().unwrap();
+        assert_eq!(
+            c,
+            DVec2::new((x0 + x1 + 1) as f64 / 2.0, (y0 + y1 + 1) as f64 / 2.0)
+        );
+        let [m20, m11, m02] = mo.central_second().unwrap();
+        assert!((m20 - (a * a - 1.0) / 12.0).abs() < 1e-9, "{m20}");
+        assert!(m11.abs() < 1e-9, "{m11}");
+        assert!((m02 - (b * b - 1.0) / 12.0).abs() < 1e-9, "{m02}");
+
+        // A diagonal line has positive mu11 (x and y grow together).
+        let d = Mask::from_fn(30, 30, |x, y| x == y);
+        let [_, m11, _] = d.moments().central_second().unwrap();
+        assert!(m11 > 0.0);
+
+        let empty = Mask::new(30, 30).moments();
+        assert_eq!(empty.count, 0.0);
+        assert_eq!(empty.centroid(), None);
+        assert_eq!(empty.central_second(), None);
+    }
+
+    #[test]
+    fn moments_match_per_pixel_reference() {
+        let mut rng = Rng(7);
+        for &(w, h) in &[(64, 3), (130, 40), (640, 20)] {
+            for density in [5, 50, 95, 100] {
+                let m = random_mask(&mut rng, w, h, density);
+                let mut r = Moments::default();
+                for y in 0..h {
+                    for x in 0..w {
+                        if m.get(x, y) {
+                            let (fx, fy) = (x as f64 + 0.5, y as f64 + 0.5);
+                            r.count += 1.0;
+                            r.sum_x += fx;
+                            r.sum_y += fy;
+                            r.sum_xx += fx * fx;
+                            r.sum_xy += fx * fy;
+                            r.sum_yy += fy * fy;
+                        }
+                    }
+                }
+                // Both sides are exact integers / quarters well below 2^53.
+                assert_eq!(m.moments(), r, "{w}x{h} density {density}");
+            }
+        }
+    }
+
+    /// Per-pixel reference morphology with "outside counts as 0".
+    fn morph_reference(m: &Mask, k: usize, erode: bool) -> Mask {
+        let r = (k / 2) as isize;
+        let (w, h) = (m.width() as isize, m.height() as isize);
+        Mask::from_fn(m.width(), m.height(), |x, y| {
+            let mut any = false;
+            let mut all = true;
+            for dy in -r..=r {
+                for dx in -r..=r {
+                    let (xx, yy) = (x as isize + dx, y as isize + dy);
+                    let v =
+                        xx >= 0 && yy >= 0 && xx < w && yy < h && m.get(xx as usize, yy as usize);
+                    any |= v;
+                    all &= v;
+                }
+            }
+            if erode {
+                all
+            } else {
+                any
+            }
+        })
+    }
+
+    #[test]
+    fn dilate_and_erode_hand_made() {
+        // One pixel dilates to a 5x5 square, clipped at the image border.
+        let mut m = Mask::new(70, 20);
+        m.set(64, 10);
+        let d = m.dilate(5);
+        assert_eq!(
+            d,
+            Mask::from_fn(70, 20, |x, y| (62..=66).contains(&x)
+                && (8..=12).contains(&y))
+        );
+        let mut corner = Mask::new(70, 20);
+        corner.set(69, 0);
+        assert_eq!(corner.dilate(5).count(), 9);
+        assert!(padding_is_zero(&corner.dilate(5)));
+        // The 5x5 square erodes back to the single pixel.
+        assert_eq!(d.erode(5), m);
+        // A full mask erodes to everything at least 2 pixels from the border.
+        let mut full = Mask::new(70, 20);
+        full.fill_all();
+        let e = full.erode(5);
+        assert_eq!(
+            e,
+            Mask::from_fn(70, 20, |x, y| (2..68).contains(&x) && (2..18).contains(&y))
+        );
+        assert_eq!(full.dilate(5), full);
+        assert_eq!(full.erode(1), full);
+        assert_eq!(Mask::new(70, 20).dilate(5), Mask::new(70, 20));
+    }
+
+    #[test]
+    fn dilate_and_erode_match_reference() {
+        let mut rng = Rng(3);
+        for &(w, h) in &[(10, 10), (64, 12), (130, 25)] {
+            for k in [1, 3, 5, 7] {
+                for density in [30, 90] {
+                    let m = random_mask(&mut rng, w, h, density);
+                    assert_eq!(
+                        m.dilate(k),
+                        morph_reference(&m, k, false),
+                        "dilate {w}x{h} k={k}"
+                    );
+                    assert_eq!(
+                        m.erode(k),
+                        morph_reference(&m, k, true),
+                        "erode {w}x{h} k={k}"
+                    );
+                    assert!(padding_is_zero(&m.dilate(k)));
+                }
+            }
+        }
+    }
+
+    /// Timing report; run with
+    /// `cargo test --release mask::tests::timing -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn timing() {
+        use std::hint::black_box;
+        use std::time::Instant;
+        let disc = |cx: f64, cy: f64, r: f64| {
+            Mask::from_fn(640, 480, move |x, y| {
+                let (dx, dy) = (x as f64 + 0.5 - cx, y as f64 + 0.5 - cy);
+                dx * dx + dy * dy <= r * r
+            })
+        };
+        let mut a = disc(300.0, 240.0, 150.0);
+        a.or_assign(&disc(100.0, 100.0, 60.0));
+        let mut b = disc(320.0, 250.0, 140.0);
+        // Make both masks span every row, the worst case for the row-range skipping.
+        a.fill_span(0, 0, 639);
+        b.fill_span(479, 0, 639);
+        let n = 20_000;
+        // The machine's speed drifts, so report the best and the median of 30 batches.
+        let time = |name: &str, f: &mut dyn FnMut() -> u64| {
+            let mut s = 0;
+            let mut per_call: Vec<f64> = (0..30)
+                .map(|_| {
+                    let t = Instant::now();
+                    for _ in 0..n / 30 {
+                        s += f();
+                    }
+                    t.elapsed().as_secs_f64() / (n / 30) as f64 * 1e6
+                })
+                .collect();
+            per_call.sort_by(f64::total_cmp);
+            println!(
+                "{name:<28} best {:8.3} us   median {:8.3} us   (checksum {s})",
+                per_call[0], per_call[15]
+            );
+        };
+        time("xor_count 640x480", &mut || {
+            black_box(&a).xor_count(black_box(&b))
+        });
+        time("and_count 640x480", &mut || {
+            black_box(&a).and_count(black_box(&b))
+        });
+        time("and_not_count 640x480", &mut || {
+            black_box(&a).and_not_count(black_box(&b))
+        });
+        time("count 640x480", &mut || black_box(&a).count());
+        time("moments 640x480", &mut || {
+            black_box(&a).moments().count as u64
+        });
+        let mut c = a.clone();
+        time("clear (full rows) 640x480", &mut || {
+            c.fill_span(0, 0, 0);
+            c.fill_span(479, 0, 0);
+            c.clear();
+            c.row_range().len() as u64
+        });
+    }
+}

@@ -1,0 +1,520 @@
+//! The optimisation driver: stages of CMA-ES over the launch velocities.
+//!
+//! Main types: [`SolveOptions`], [`Observer`] (how the caller watches and saves: the
+//! CLI draws progress bars, writes previews and saves after every stage; this module
+//! touches no file), [`Solution`] (what `solution.json` holds) and [`SampleRecord`]
+//! (one row of `convergence.csv`).
+//!
+//! Data flow of [`solve`]: for each stage (a scheduled stage, or one occluder of the
+//! sequential strategy, then the final joint stage), CMA-ES starts at the best launch
+//! of the previous stage over the stage's varying occluders (the others are held
+//! fixed), `ask`s a population, the samples are evaluated in parallel on a rayon pool
+//! with one [`Workspace`] per thread, `tell`s the energies back, and stops on target
+//! energy, stagnation, tolerance or the iteration cap.
+//!
+//! Determinism: candidates come from one seeded RNG per stage in `ask`, and each
+//! sample's energy is a pure function of its launch values, so the result is
+//! bit-identical for a seed whatever the number of threads.
+//!
+//! Interrupts: the caller passes a counter that a Ctrl-C handler increments. One
+//! interrupt ends the current stage (the next one starts from its best); a second one
+//! stops the solve, which still returns the best so far.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::cmaes::{Cmaes, CmaesConfig, StopReason};
+use crate::energy::{Term, Weights, TERM_COUNT};
+use crate::evaluate::{launch_velocities, Evaluation, Problem, Workspace};
+use crate::mask::Mask;
+use crate::scene::Stage;
+
+/// How to run a solve.
+#[derive(Clone, Debug, Default)]
+pub struct SolveOptions {
+    /// Worker threads (None: one per core).
+    pub threads: Option<usize>,
+    /// Overrides the scene's seed.
+    pub seed: Option<u64>,
+    /// Continue a saved solution: its completed stages are skipped and the next stage
+    /// starts from its launch values.
+    pub resume: Option<Solution>,
+}
+
+/// Progress of one iteration, for progress bars and previews.
+#[derive(Clone, Debug)]
+pub struct IterationInfo<'a> {
+    pub stage_index: usize,
+    pub stage: &'a Stage,
+    pub iteration: usize,
+    pub samples: usize,
+    /// Best total energy of the stage so far.
+    pub best_energy: f64,
+    /// IoU at t of the stage's best so far.
+    pub best_iou: f64,
+    /// Samples per second over the stage so far.
+    pub samples_per_second: f64,
+    /// The stage's best shadow at t.
+    pub best_shadow: &'a Mask,
+}
+
+/// Receives progress; implemented by the CLI (progress bars, preview PNG, saving).
+pub trait Observer {
+    fn stage_started(&mut self, _index: usize, _stage: &Stage) {}
+    fn iteration(&mut self, _info: &IterationInfo) {}
+    /// Called after each stage with the solution so far (save it: nothing is lost).
+    fn stage_finished(&mut self, _solution: &Solution, _records: &[SampleRecord]) {}
+}
+
+/// An observer that ignores everything (tests, benchmarks).
+pub struct Silent;
+impl Observer for Silent {}
+
+/// One evaluated sample: a row of `convergence.csv`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SampleRecord {
+    pub stage: usize,
+    pub iteration: usize,
+    /// Weighted value of each term, in [`Term::ALL`] order.
+    pub terms: [f64; TERM_COUNT],
+    pub total: f64,
+}
+
+/// Launch of one occluder.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Launch {
+    pub name: String,
+    pub launched: bool,
+    /// Centre-of-mass launch velocity (m/s, world).
+    pub velocity: [f64; 3],
+    /// Launch angular velocity (rad/s, world).
+    pub angular_velocity: [f64; 3],
+}
+
+/// Value of one energy term.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TermValue {
+    pub raw: f64,
+    pub weighted: f64,
+}
+
+/// Summary of one stage.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StageReport {
+    pub name: String,
+    pub iterations: usize,
+    pub samples: usize,
+    pub population: usize,
+    pub best_energy: f64,
+    pub iou: f64,
+    pub stop: String,
+    pub wall_time_s: f64,
+}
+
+/// Everything `solution.json` holds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Solution {
+    pub scene: String,
+    pub seed: u64,
+    pub t: f64,
+    pub stages_total: usize,
+    pub stages_completed: usize,
+    /// True when the solve ran every stage to its own stop (not cut short by Ctrl-C).
+    pub complete: bool,
+    pub occluders: Vec<Launch>,
+    /// Every term at the solution, raw and weighted with the last completed stage's weights.
+    pub energy: std::collections::BTreeMap<String, TermValue>,
+    pub total_energy: f64,
+    pub iou: f64,
+    pub t_sim: f64,
+    pub n_contacts: u32,
+    pub samples: usize,
+    pub iterations: usize,
+    pub wall_time_s: f64,
+    pub threads: usize,
+    /// Mean time per phase of one sample on one core (microseconds).
+    pub time_per_term_us: std::collections::BTreeMap<String, f64>,
+    pub stages: Vec<StageReport>,
+}
+
+impl Solution {
+    /// The launch values as the solver's parameter vector (6 per occluder).
+    pub fn parameters(&self) -> Vec<f64> {
+        self.occluders
+            .iter()
+            .flat_map(|o| o.velocity.iter().chain(o.angular_velocity.iter()).copied())
+            .collect()
+    }
+}
+
+/// Why a solution does not belong to a scene.
+#[derive(Debug, thiserror::Error)]
+pub enum MismatchError {
+    #[error("the solution is for scene `{found}`, not `{expected}`")]
+    Scene { expected: String, found: String },
+    #[error("the solution has {found} occluders, the scene has {expected}")]
+    Count { expected: usize, found: usize },
+    #[error("occluder {index} is `{found}` in the solution but `{expected}` in the scene")]
+    Name {
+        index: usize,
+        expected: String,
+        found: String,
+    },
+    #[error("the solution has {found} stages, the scene has {expected}")]
+    Stages { expected: usize, found: usize },
+    #[error("the solution holds a non-finite launch value for `{name}`")]
+    NotFinite { name: String },
+}
+
+/// Check that a solution was made for this scene (names and counts match).
+pub fn check_solution(problem: &Problem, s: &Solution) -> Result<(), MismatchError> {
+    let scene = &problem.scene;
+    if s.scene != scene.name {
+        return Err(MismatchError::Scene {
+            expected: scene.name.clone(),
+            found: s.scene.clone(),
+        });
+    }
+    if s.occluders.len() != scene.occluders.len() {
+        return Err(MismatchError::Count {
+            expected: scene.occluders.len(),
+            found: s.occluders.len(),
+        });
+    }
+    for (i, (a, b)) in scene.occluders.iter().zip(&s.occluders).enumerate() {
+        if a.name != b.name {
+            return Err(MismatchError::Name {
+                index: i,
+                expected: a.name.clone(),
+                found: b.name.clone(),
+            });
+        }
+        if b.velocity
+            .iter()
+            .chain(&b.angular_velocity)
+            .any(|x| !x.is_finite())
+        {
+            return Err(MismatchError::NotFinite {
+                name: b.name.clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Per-thread workspaces, indexed by rayon's thread index. Each is only ever locked by
+/// its own thread, so the locks are uncontended; they exist to satisfy the borrow rules.
+struct Pool {
+    pool: rayon::ThreadPool,
+    workspaces: Vec<Mutex<Workspace>>,
+}
+
+impl Pool {
+    fn new(problem: &Problem, threads: usize) -> Pool {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("building a rayon thread pool only fails if threads cannot be spawned");
+        let workspaces = (0..threads)
+            .map(|_| Mutex::new(problem.workspace()))
+            .collect();
+        Pool { pool, workspaces }
+    }
+
+    /// Evaluate every row of `candidates` (`n` values each, the stage's subset) into `out`.
+    fn evaluate(
+        &self,
+        problem: &Problem,
+        base: &[f64],
+        stage: &Stage,
+        candidates: &[f64],
+        n: usize,
+        out: &mut [Evaluation],
+    ) {
+        let full = base.len();
+        self.pool.install(|| {
+            out.par_iter_mut().enumerate().for_each_init(
+                || vec![0.0; full],
+                |params, (k, slot)| {
+                    problem.expand(base, &stage.vary, &candidates[k * n..(k + 1) * n], params);
+                    let idx = rayon::current_thread_index().unwrap_or(0) % self.workspaces.len();
+                    let mut ws = self.workspaces[idx]
+                        .lock()
+                        .unwrap_or_else(|e| e.into_inner());
+                    *slot = problem.evaluate(params, &stage.weights, &mut ws);
+                },
+            );
+        });
+    }
+}
+
+/// Seed of stage `k`'s CMA-ES: a SplitMix64 step, so that every stage of every seed has
+/// its own stream and a resumed solve draws exactly what an uninterrupted one would.
+fn stage_seed(seed: u64, k: usize) -> u64 {
+    let mut z = seed.wrapping_add(0x9E37_79B9_7F4A_7C15u64.wrapping_mul(k as u64 + 1));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+fn stop_name(s: Option<StopReason>, interrupted: bool) -> String {
+    if interrupted {
+        return "interrupted".into();
+    }
+    match s {
+        Some(StopReason::TargetReached) => "target energy reached",
+        Some(StopReason::TolFun) => "energy tolerance",
+        Some(StopReason::TolX) => "step tolerance",
+        Some(StopReason::Stagnation) => "stagnation",
+        Some(StopReason::MaxGenerations) => "iteration cap",
+        Some(StopReason::ConditionNumber) => "ill-conditioned covariance",
+        None => "iteration cap",
+    }
+    .into()
+}
+
+/// Run the optimisation. Returns the solution (also after interrupts) and every sample.
+pub fn solve(
+    problem: &Problem,
+    options: &SolveOptions,
+    observer: &mut dyn Observer,
+    interrupts: &AtomicUsize,
+) -> (Solution, Vec<SampleRecord>) {
+    let scene = &problem.scene;
+    let seed = options.seed.unwrap_or(scene.seed);
+    let threads = options
+        .threads
+        .unwrap_or_else(|| {
+            std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1)
+        })
+        .max(1);
+    let pool = Pool::new(problem, threads);
+    let start = Instant::now();
+
+    let (mut params, first_stage, mut records, mut reports, prior_time) = match &options.resume {
+        Some(s) => (
+            s.parameters(),
+            s.stages_completed,
+            Vec::new(),
+            s.stages.clone(),
+            s.wall_time_s,
+        ),
+        None => (scene.start_parameters(), 0, Vec::new(), Vec::new(), 0.0),
+    };
+    let mut aborted = false;
+
+    for (k, stage) in scene.stages.iter().enumerate().skip(first_stage) {
+        if interrupts.load(Ordering::SeqCst) >= 2 {
+            aborted = true;
+            break;
+        }
+        observer.stage_started(k, stage);
+        let stage_start = Instant::now();
+        let interrupts_at_start = interrupts.load(Ordering::SeqCst);
+        let n = 6 * stage.vary.len();
+        let mut x0 = vec![0.0; n];
+        for (j, &i) in stage.vary.iter().enumerate() {
+            x0[6 * j..6 * j + 6].copy_from_slice(&params[6 * i..6 * i + 6]);
+        }
+        let config = CmaesConfig {
+            population: Some(stage.population),
+            max_generations: stage.max_iterations,
+            f_target: stage.target_energy,
+            tol_fun: stage.tol_fun,
+            stagnation_window: stage.stagnation,
+            ..CmaesConfig::default()
+        };
+        let mut cma = Cmaes::new(&x0, stage.step, config, stage_seed(seed, k));
+        let lambda = cma.population();
+        let mut evals = vec![
+            Evaluation {
+                raw: [0.0; TERM_COUNT],
+                total: 0.0,
+                outcome: crate::evaluate::Outcome {
+                    t_sim: 0.0,
+                    n_contacts: 0,
+                    first_contact: None
+                },
+                iou: 0.0
+            };
+            lambda
+        ];
+        let mut fitness = vec![0.0; lambda];
+        let mut best_params = params.clone();
+        let mut best_eval = problem.evaluate(&params, &stage.weights, &mut problem.workspace());
+        // The stage's own record of its best: the stage starts from the previous best,
+        // which it must never end worse than.
+        let mut ws = problem.workspace();
+        let mut best_mask = {
+            problem.evaluate(&best_params, &stage.weights, &mut ws);
+            ws.mask.clone()
+        };
+        let mut iteration = 0;
+        let mut interrupted = false;
+        let mut scratch = vec![0.0; params.len()];
+        let mut candidates = vec![0.0; lambda * n];
+        let stop = loop {
+            if interrupts.load(Ordering::SeqCst) > interrupts_at_start {
+                interrupted = true;
+                break None;
+            }
+            candidates.copy_from_slice(cma.ask());
+            pool.evaluate(problem, &params, stage, &candidates, n, &mut evals);
+            let mut improved = None;
+            for (j, e) in evals.iter().enumerate() {
+                fitness[j] = e.total;
+                records.push(SampleRecord {
+                    stage: k,
+                    iteration,
+                    terms: e.weighted(&stage.weights),
+                    total: e.total,
+                });
+                if e.total < best_eval.total {
+                    best_eval = *e;
+                    improved = Some(j);
+                }
+            }
+            if let Some(j) = improved {
+                problem.expand(
+                    &params,
+                    &stage.vary,
+                    &candidates[j * n..(j + 1) * n],
+                    &mut scratch,
+                );
+                best_params.copy_from_slice(&scratch);
+                problem.evaluate(&best_params, &stage.weights, &mut ws);
+                best_mask.clone_from(&ws.mask);
+            }
+            cma.tell(&fitness);
+            iteration += 1;
+            let elapsed = stage_start.elapsed().as_secs_f64();
+            observer.iteration(&IterationInfo {
+                stage_index: k,
+                stage,
+                iteration,
+                samples: cma.evaluations(),
+                best_energy: best_eval.total,
+                best_iou: best_eval.iou,
+                samples_per_second: cma.evaluations() as f64 / elapsed.max(1e-9),
+                best_shadow: &best_mask,
+            });
+            if let Some(s) = cma.stop() {
+                break Some(s);
+            }
+        };
+        params.copy_from_slice(&best_params);
+        reports.push(StageReport {
+            name: stage.name.clone(),
+            iterations: iteration,
+            samples: cma.evaluations(),
+            population: lambda,
+            best_energy: best_eval.total,
+            iou: best_eval.iou,
+            stop: stop_name(stop, interrupted),
+            wall_time_s: stage_start.elapsed().as_secs_f64(),
+        });
+        let wall = prior_time + start.elapsed().as_secs_f64();
+        let s = summarize(
+            problem,
+            seed,
+            &params,
+            k + 1,
+            &reports,
+            wall,
+            threads,
+            false,
+            None,
+        );
+        observer.stage_finished(&s, &records);
+        if interrupted && interrupts.load(Ordering::SeqCst) >= 2 {
+            aborted = true;
+            break;
+        }
+    }
+    let completed = reports.len();
+    let wall = prior_time + start.elapsed().as_secs_f64();
+    let complete = !aborted
+        && completed == scene.stages.len()
+        && reports.iter().all(|r| r.stop != "interrupted");
+    let mut ws = problem.workspace();
+    let timing = problem.profile(&params, 200, &mut ws);
+    let s = summarize(
+        problem,
+        seed,
+        &params,
+        completed,
+        &reports,
+        wall,
+        threads,
+        complete,
+        Some(timing),
+    );
+    (s, records)
+}
+
+/// Build a [`Solution`] for the launch values `params`.
+#[allow(clippy::too_many_arguments)]
+pub fn summarize(
+    problem: &Problem,
+    seed: u64,
+    params: &[f64],
+    stages_completed: usize,
+    reports: &[StageReport],
+    wall_time_s: f64,
+    threads: usize,
+    complete: bool,
+    timing: Option<Vec<(String, f64)>>,
+) -> Solution {
+    let scene = &problem.scene;
+    let mut ws = problem.workspace();
+    let all = problem.evaluate(params, &Weights::all_ones(), &mut ws);
+    let weights = scene.stages[stages_completed.clamp(1, scene.stages.len()) - 1].weights;
+    let mut energy = std::collections::BTreeMap::new();
+    let mut total = 0.0;
+    for t in Term::ALL {
+        let raw = all.raw[t as usize];
+        let weighted = raw * weights.get(t);
+        total += weighted;
+        energy.insert(t.key().to_string(), TermValue { raw, weighted });
+    }
+    let occluders = scene
+        .occluders
+        .iter()
+        .enumerate()
+        .map(|(i, o)| {
+            let (v, w) = launch_velocities(params, i);
+            Launch {
+                name: o.name.clone(),
+                launched: o.launched,
+                velocity: v.to_array(),
+                angular_velocity: w.to_array(),
+            }
+        })
+        .collect();
+    Solution {
+        scene: scene.name.clone(),
+        seed,
+        t: scene.t,
+        stages_total: scene.stages.len(),
+        stages_completed,
+        complete,
+        occluders,
+        energy,
+        total_energy: total,
+        iou: all.iou,
+        t_sim: all.outcome.t_sim,
+        n_contacts: all.outcome.n_contacts,
+        samples: reports.iter().map(|r| r.samples).sum(),
+        iterations: reports.iter().map(|r| r.iterations).sum(),
+        wall_time_s,
+        threads,
+        time_per_term_us: timing.unwrap_or_default().into_iter().collect(),
+        stages: reports.to_vec(),
+    }
+}
