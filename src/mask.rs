@@ -283,25 +283,24 @@ impl Mask {
     /// Popcount of `op(a, b)` over a word range, with four independent accumulators so
     /// the popcounts of consecutive words can overlap in the pipeline.
     #[inline(always)]
-    fn pair_count(&self, other: &Mask, op: impl Fn(u64, u64) -> u64) -> u64 {
+    fn pair_count(&self, other: &Mask, op: impl Fn(u64, u64) -> u64 + Copy) -> u64 {
         let r = self.union_words(other);
         let a = &self.words[r.clone()];
         let b = &other.words[r];
-        let mut acc = [0u64; 4];
-        let mut ca = a.chunks_exact(4);
-        let mut cb = b.chunks_exact(4);
-        for (x, y) in (&mut ca).zip(&mut cb) {
-            for k in 0..4 {
-                acc[k] += op(x[k], y[k]).count_ones() as u64;
+        #[cfg(target_arch = "x86_64")]
+        {
+            // With AVX2, LLVM vectorises the popcount (a nibble lookup with vpshufb), about
+            // twice as fast as scalar POPCNT. The check is cached by std and costs a load.
+            if std::arch::is_x86_feature_detected!("avx512vpopcntdq") {
+                // SAFETY: the CPU supports AVX-512F and VPOPCNTDQ, checked just above.
+                return unsafe { pair_count_avx512(a, b, op) };
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU supports AVX2, checked just above.
+                return unsafe { pair_count_avx2(a, b, op) };
             }
         }
-        let tail: u64 = ca
-            .remainder()
-            .iter()
-            .zip(cb.remainder())
-            .map(|(&x, &y)| op(x, y).count_ones() as u64)
-            .sum();
-        acc.iter().sum::<u64>() + tail
+        pair_count_words(a, b, op)
     }
 
     /// Number of pixels set in exactly one of the masks.
@@ -517,6 +516,49 @@ impl fmt::Debug for Mask {
     }
 }
 
+/// Popcount of `op(a[i], b[i])` summed over the words, with four accumulators so the
+/// adds do not form one long dependency chain.
+#[inline(always)]
+fn pair_count_words(a: &[u64], b: &[u64], op: impl Fn(u64, u64) -> u64) -> u64 {
+    let mut acc = [0u64; 4];
+    let mut ca = a.chunks_exact(4);
+    let mut cb = b.chunks_exact(4);
+    for (x, y) in (&mut ca).zip(&mut cb) {
+        for k in 0..4 {
+            acc[k] += op(x[k], y[k]).count_ones() as u64;
+        }
+    }
+    let tail: u64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(&x, &y)| op(x, y).count_ones() as u64)
+        .sum();
+    acc.iter().sum::<u64>() + tail
+}
+
+/// The same count compiled for AVX-512 with the vector popcount instruction (VPOPCNTQ).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vpopcntdq")]
+unsafe fn pair_count_avx512(a: &[u64], b: &[u64], op: impl Fn(u64, u64) -> u64) -> u64 {
+    a.iter()
+        .zip(b)
+        .map(|(&x, &y)| op(x, y).count_ones() as u64)
+        .sum()
+}
+
+/// The same count compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn pair_count_avx2(a: &[u64], b: &[u64], op: impl Fn(u64, u64) -> u64) -> u64 {
+    // A plain iterator sum: LLVM turns it into vector popcounts, which the manual
+    // four-accumulator unroll of the scalar version would prevent.
+    a.iter()
+        .zip(b)
+        .map(|(&x, &y)| op(x, y).count_ones() as u64)
+        .sum()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -611,6 +653,26 @@ mod tests {
         assert_eq!(a, b);
         let c = Mask::from_fn(10, 10, |x, y| (x, y) == (3, 3));
         assert_ne!(a, c);
+    }
+
+    #[test]
+    fn every_popcount_kernel_agrees() {
+        // The dispatch picks one kernel per machine; check the others here too.
+        let mut rng = Rng(7);
+        let a = random_mask(&mut rng, 640, 48, 40);
+        let b = random_mask(&mut rng, 640, 48, 60);
+        let op = |x: u64, y: u64| x ^ y;
+        let scalar = pair_count_words(&a.words, &b.words, op);
+        assert_eq!(scalar, a.xor_count(&b));
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                assert_eq!(unsafe { pair_count_avx2(&a.words, &b.words, op) }, scalar);
+            }
+            if std::arch::is_x86_feature_detected!("avx512vpopcntdq") {
+                assert_eq!(unsafe { pair_count_avx512(&a.words, &b.words, op) }, scalar);
+            }
+        }
     }
 
     #[test]
