@@ -158,7 +158,7 @@ impl TriMesh {
 #[derive(Debug, thiserror::Error)]
 pub enum ObjError {
     /// The file could not be opened or read, or tobj could not parse it.
-    #[error("cannot read or parse OBJ file {path}: {source}")]
+    #[error("cannot read or parse OBJ file {path}")]
     Load {
         path: PathBuf,
         #[source]
@@ -337,6 +337,23 @@ impl Shape {
             Shape::Cuboid { half_extents: h } => 8.0 * h.x * h.y * h.z,
             Shape::Mesh(mesh) => mesh.signed_volume().abs(),
         }
+    }
+
+    /// [`Shape::mass_properties`], or `None` when the result is not usable for flight
+    /// (a mass or principal moment that is zero, negative or not finite: a shape too small
+    /// or too large for f64).
+    pub fn mass_properties_checked(&self, density: f64) -> Option<MassProperties> {
+        let v = self.volume();
+        if !(density.is_finite() && density > 0.0 && v.is_finite() && v > 0.0) {
+            return None;
+        }
+        let mp = self.mass_properties(density);
+        let ok = mp.mass.is_finite()
+            && mp.mass > 0.0
+            && mp.principal_inertia.is_finite()
+            && mp.principal_inertia.min_element() > 0.0
+            && mp.local_com.is_finite();
+        ok.then_some(mp)
     }
 
     /// Mass properties of the solid at uniform `density` (kg/m^3 for metres).

@@ -1,7 +1,10 @@
 //! The `bsa` command line: argument parsing and the subcommands.
 //!
 //! Subcommands: `check` (validate a scene and print a summary), `solve` (optimise and
-//! write `export/<scene>/`), `eval` (print every energy term of a saved solution).
+//! write `export/<scene>/`), `eval` (print every energy term of a saved solution),
+//! `export` (animated glTF and launch tables of a saved solution), `validate` (Blender
+//! Cycles shadow against the rasterizer) and `video` (an MP4 of the flight). `validate`
+//! and `video` run the scripts of `blender/` with a Python that has `bpy`.
 //! This is the only module that uses `anyhow`, prints, draws progress bars or installs
 //! the Ctrl-C handler; library modules return typed errors.
 
@@ -62,6 +65,50 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Write the animated glTF (<scene>.glb), launch.csv and trajectory.csv of a saved solution.
+    Export {
+        /// Output folder of a solve (holding solution.json).
+        dir: PathBuf,
+        /// Scene folder or file [default: the one recorded in solution.json, else scenes/<name>].
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Seconds of rapier continuation after t.
+        #[arg(long, default_value_t = crate::trajectory::DEFAULT_AFTER)]
+        after: f64,
+    },
+    /// Render the shadow at t with Blender Cycles and compare it with the rasterizer (IoU, XOR).
+    Validate {
+        /// Output folder of a solve or export (holding solution.json and <scene>.glb).
+        dir: PathBuf,
+        /// Scene folder or file [default: as for `export`].
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Python with the `bpy` module [default: $BSA_PYTHON, else .venv-blender/bin/python].
+        #[arg(long)]
+        python: Option<PathBuf>,
+    },
+    /// Render an MP4 of the flight with Blender from the perspective camera.
+    Video {
+        /// Output folder of a solve or export (holding solution.json and <scene>.glb).
+        dir: PathBuf,
+        /// Output file [default: DIR/<scene>.mp4].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Cycles samples per pixel.
+        #[arg(long, default_value_t = 4)]
+        samples: u32,
+        /// Frame size in pixels.
+        #[arg(long, default_value_t = 640)]
+        width: u32,
+        #[arg(long, default_value_t = 480)]
+        height: u32,
+        /// Render only the first SECONDS of the animation.
+        #[arg(long)]
+        seconds: Option<f64>,
+        /// Python with the `bpy` module [default: $BSA_PYTHON, else .venv-blender/bin/python].
+        #[arg(long)]
+        python: Option<PathBuf>,
+    },
     /// Print every energy term of a solution, raw and weighted.
     Eval {
         /// Scene folder (holding scene.json) or scene file.
@@ -97,6 +144,23 @@ pub fn run(cli: Cli) -> Result<()> {
             stage,
             json,
         } => eval(&scene, &solution, stage, json),
+        Command::Export { dir, scene, after } => {
+            let (problem, solution) = load_solution_dir(&dir, scene.as_deref())?;
+            if !(after.is_finite() && after >= 0.0) {
+                bail!("--after must be a non-negative number of seconds, got {after}");
+            }
+            write_exports(&dir, &problem, &solution, after)
+        }
+        Command::Validate { dir, scene, python } => validate(&dir, scene.as_deref(), python),
+        Command::Video {
+            dir,
+            out,
+            samples,
+            width,
+            height,
+            seconds,
+            python,
+        } => video(&dir, out, samples, width, height, seconds, python),
     }
 }
 
@@ -281,8 +345,10 @@ fn solve(
 ) -> Result<()> {
     let scene = load_scene(path)?;
     let out = out.unwrap_or_else(|| PathBuf::from("export").join(&scene.name));
-    if threads == Some(0) {
-        bail!("--threads must be at least 1");
+    if let Some(n) = threads {
+        if !(1..=1024).contains(&n) {
+            bail!("--threads must be between 1 and 1024, got {n}");
+        }
     }
     let problem = Problem::new(scene);
     let scene = &problem.scene;
@@ -342,6 +408,8 @@ fn solve(
         stages_total: scene.stages.len(),
         error: None,
     };
+    // A resumed solve keeps the seed it was started with.
+    let seed = resume_from.as_ref().map(|s| s.seed).or(seed);
     let options = SolveOptions {
         threads,
         seed,
@@ -360,6 +428,7 @@ fn solve(
     problem.evaluate(&params, &Weights::all_ones(), &mut ws);
     export::write_pictures(&out, &scene.target, &ws.mask)?;
     export::write_preview(&out, &scene.target, &ws.mask)?;
+    write_exports(&out, &problem, &solution, crate::trajectory::DEFAULT_AFTER)?;
     println!(
         "{}: IoU at t {:.4}, {} before t ({} contacts), {} samples in {} iterations, {:.2} s on {} threads{}",
         scene.name,
@@ -380,6 +449,278 @@ fn solve(
     if report {
         print_report(&solution);
     }
+    Ok(())
+}
+
+/// Load `DIR/solution.json` and its scene, and check that they belong together.
+fn load_solution_dir(dir: &Path, scene: Option<&Path>) -> Result<(Problem, Solution)> {
+    let file = dir.join("solution.json");
+    if !file.is_file() {
+        bail!(
+            "{} has no solution.json: run `bsa solve <scene> --out {}` first",
+            dir.display(),
+            dir.display()
+        );
+    }
+    let solution = export::read_solution(&file)?;
+    let scene_path = match scene {
+        Some(p) => p.to_path_buf(),
+        None => solution
+            .scene_file
+            .as_ref()
+            .map(PathBuf::from)
+            .filter(|p| p.exists())
+            .unwrap_or_else(|| PathBuf::from("scenes").join(&solution.scene)),
+    };
+    let problem = Problem::new(load_scene(&scene_path)?);
+    solver::check_solution(&problem, &solution).with_context(|| {
+        format!(
+            "{} does not belong to the scene {} (pass the right one with --scene)",
+            file.display(),
+            scene_path.display()
+        )
+    })?;
+    Ok((problem, solution))
+}
+
+/// `<scene>.glb`, `launch.csv` and `trajectory.csv`.
+fn write_exports(dir: &Path, problem: &Problem, solution: &Solution, after: f64) -> Result<()> {
+    let params = solution.parameters();
+    let track = crate::trajectory::track(problem, &params, after);
+    let name = &problem.scene.name;
+    let traj = crate::gltf_export::Trajectory {
+        times: track.times.clone(),
+        poses: track.poses.clone(),
+        t_index: track.t_index,
+        fps: track.fps,
+    };
+    let glb = crate::gltf_export::write_glb(&problem.scene, &traj)
+        .context("cannot build the glTF file")?;
+    export::write_atomic(&dir.join(format!("{name}.glb")), &glb)?;
+    export::write_csv(
+        &dir.join("launch.csv"),
+        &crate::trajectory::launch_rows(problem, &params),
+    )?;
+    export::write_csv(
+        &dir.join("trajectory.csv"),
+        &crate::trajectory::trajectory_rows(problem, &track),
+    )?;
+    println!(
+        "wrote {}/{{{name}.glb, launch.csv, trajectory.csv}}: {} keys, t = {} s at key {}",
+        dir.display(),
+        track.times.len(),
+        problem.scene.t,
+        track.t_index
+    );
+    Ok(())
+}
+
+/// The Python interpreter that has `bpy`: `--python`, else `$BSA_PYTHON`, else
+/// `.venv-blender/bin/python` in the current folder or a parent.
+fn blender_python(explicit: Option<PathBuf>) -> Result<PathBuf> {
+    if let Some(p) = explicit.or_else(|| std::env::var_os("BSA_PYTHON").map(PathBuf::from)) {
+        if !p.exists() {
+            bail!("the Python interpreter {} does not exist", p.display());
+        }
+        return Ok(p);
+    }
+    let cwd = std::env::current_dir().context("cannot read the current folder")?;
+    for dir in cwd.ancestors() {
+        let p = dir.join(".venv-blender/bin/python");
+        if p.exists() {
+            return Ok(p);
+        }
+    }
+    bail!(
+        "no Python with Blender's bpy module found: run `bash blender/setup_venv.sh` (needs Python 3.11) \
+         from the repository, or pass --python / set BSA_PYTHON"
+    )
+}
+
+/// A script of the `blender/` folder, found next to the current folder or a parent.
+fn blender_script(name: &str) -> Result<PathBuf> {
+    let cwd = std::env::current_dir().context("cannot read the current folder")?;
+    for dir in cwd.ancestors() {
+        let p = dir.join("blender").join(name);
+        if p.is_file() {
+            return Ok(p);
+        }
+    }
+    bail!("cannot find blender/{name}: run bsa from the repository (or a folder inside it)")
+}
+
+/// Run a Blender script and return the JSON of its `BSA_RESULT` line.
+fn run_blender(python: &Path, script: &Path, args: &[String]) -> Result<serde_json::Value> {
+    let out = std::process::Command::new(python)
+        .arg(script)
+        .arg("--")
+        .args(args)
+        .output()
+        .with_context(|| format!("cannot run {}", python.display()))?;
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line = stdout
+        .lines()
+        .rev()
+        .find_map(|l| l.strip_prefix("BSA_RESULT "));
+    let value: Option<serde_json::Value> = line.and_then(|l| serde_json::from_str(l).ok());
+    match value {
+        Some(v) if out.status.success() && v.get("error").is_none() => Ok(v),
+        Some(v) => bail!(
+            "{} failed: {}",
+            script.display(),
+            v.get("error").unwrap_or(&v)
+        ),
+        None => {
+            let err = String::from_utf8_lossy(&out.stderr);
+            let tail: Vec<&str> = err.lines().rev().take(15).collect();
+            let tail: Vec<&str> = tail.into_iter().rev().collect();
+            if err.contains("No module named 'bpy'") {
+                bail!(
+                    "{} has no bpy module: run `bash blender/setup_venv.sh`, or pass --python",
+                    python.display()
+                );
+            }
+            bail!(
+                "{} failed ({}):\n{}",
+                script.display(),
+                out.status,
+                tail.join("\n")
+            )
+        }
+    }
+}
+
+fn glb_path(dir: &Path, problem: &Problem) -> Result<PathBuf> {
+    let glb = dir.join(format!("{}.glb", problem.scene.name));
+    if !glb.is_file() {
+        bail!(
+            "{} does not exist: run `bsa export {}` first",
+            glb.display(),
+            dir.display()
+        );
+    }
+    crate::gltf_export::read_poses_at(
+        &std::fs::read(&glb).with_context(|| format!("cannot read {}", glb.display()))?,
+        0.0,
+    )
+    .with_context(|| {
+        format!(
+            "{} is not a valid glTF file from bsa: run `bsa export {}` again",
+            glb.display(),
+            dir.display()
+        )
+    })?;
+    Ok(glb)
+}
+
+fn validate(dir: &Path, scene: Option<&Path>, python: Option<PathBuf>) -> Result<()> {
+    let (problem, solution) = load_solution_dir(dir, scene)?;
+    let glb = glb_path(dir, &problem)?;
+    let python = blender_python(python)?;
+    let script = blender_script("render_shadow.py")?;
+    let mask_path = dir.join("cycles_mask.png");
+    let result = run_blender(
+        &python,
+        &script,
+        &[
+            "--glb".into(),
+            glb.display().to_string(),
+            "--out".into(),
+            mask_path.display().to_string(),
+        ],
+    )?;
+    let target = &problem.scene.target;
+    let img = image::open(&mask_path)
+        .with_context(|| format!("cannot read the Cycles mask {}", mask_path.display()))?
+        .to_luma8();
+    if (img.width() as usize, img.height() as usize) != (target.width(), target.height()) {
+        bail!(
+            "the Cycles mask is {}x{}, the target {}x{}",
+            img.width(),
+            img.height(),
+            target.width(),
+            target.height()
+        );
+    }
+    let cycles = crate::mask::Mask::from_fn(target.width(), target.height(), |x, y| {
+        img.get_pixel(x as u32, y as u32).0[0] < 128
+    });
+    let mut ws = problem.workspace();
+    problem.evaluate(&solution.parameters(), &Weights::all_ones(), &mut ws);
+    let ours = &ws.mask;
+    let iou = crate::energy::iou(&cycles, ours);
+    let xor = cycles.xor_count(ours);
+    let diff = crate::picture::difference_image(
+        target.width(),
+        target.height(),
+        &|x, y| cycles.get(x, y),
+        &|x, y| ours.get(x, y),
+    );
+    export::save_png(&diff, &dir.join("validate_diff.png"))?;
+    let report = serde_json::json!({
+        "scene": problem.scene.name,
+        "iou": iou,
+        "xor_pixels": xor,
+        "cycles_shadow_pixels": cycles.count(),
+        "rasterizer_shadow_pixels": ours.count(),
+        "cycles_mask": mask_path.display().to_string(),
+        "difference_image": dir.join("validate_diff.png").display().to_string(),
+        "blender": result,
+    });
+    export::write_atomic(
+        &dir.join("validate.json"),
+        serde_json::to_string_pretty(&report)?.as_bytes(),
+    )?;
+    println!(
+        "{}: Cycles vs rasterizer at t: IoU {:.5}, {} XOR pixels ({} vs {} shadow pixels); difference image {} (black both, red Cycles only, blue rasterizer only)",
+        problem.scene.name,
+        iou,
+        xor,
+        cycles.count(),
+        ours.count(),
+        dir.join("validate_diff.png").display()
+    );
+    Ok(())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn video(
+    dir: &Path,
+    out: Option<PathBuf>,
+    samples: u32,
+    width: u32,
+    height: u32,
+    seconds: Option<f64>,
+    python: Option<PathBuf>,
+) -> Result<()> {
+    let (problem, _) = load_solution_dir(dir, None)?;
+    let glb = glb_path(dir, &problem)?;
+    if samples == 0 || width < 16 || height < 16 {
+        bail!("--samples must be at least 1 and the frame at least 16x16 pixels");
+    }
+    let python = blender_python(python)?;
+    let script = blender_script("render_video.py")?;
+    let out = out.unwrap_or_else(|| dir.join(format!("{}.mp4", problem.scene.name)));
+    let mut args = vec![
+        "--glb".to_string(),
+        glb.display().to_string(),
+        "--out".into(),
+        out.display().to_string(),
+        "--samples".into(),
+        samples.to_string(),
+        "--width".into(),
+        width.to_string(),
+        "--height".into(),
+        height.to_string(),
+    ];
+    if let Some(s) = seconds {
+        if !(s.is_finite() && s > 0.0) {
+            bail!("--seconds must be positive, got {s}");
+        }
+        args.extend(["--seconds".into(), s.to_string()]);
+    }
+    let result = run_blender(&python, &script, &args)?;
+    println!("wrote {} ({})", out.display(), result);
     Ok(())
 }
 

@@ -222,9 +222,17 @@ fn ball_radius(s: &ContactShape) -> f64 {
 }
 
 /// First time in `[0, horizon]` at which the two bodies touch, if any. At least one of
-/// them is flying. Both must be apart at time 0 (the scene validation guarantees it).
+/// them is flying. Bodies may start touching (validation allows up to 0.1 mm of overlap):
+/// then, as for the table, sinking [`TABLE_PENETRATION`] deeper before they have separated,
+/// or touching again after separating, is the contact.
 pub fn pair_contact_time(a: &Body, b: &Body, horizon: f64) -> Option<f64> {
     debug_assert!(a.motion.is_flying() || b.motion.is_flying());
+    let (pa, qa) = a.motion.pose(0.0);
+    let (pb, qb) = b.motion.pose(0.0);
+    let d0 = signed_distance(a.shape, pa, qa, b.shape, pb, qb);
+    if d0 <= CONTACT_DISTANCE {
+        return touching_pair_contact_time(a, b, d0, horizon);
+    }
     let both_fly = a.motion.is_flying() && b.motion.is_flying();
     let reach = a.radius + b.radius;
     // 1. Bounding spheres about the centres of mass.
@@ -279,6 +287,35 @@ pub fn pair_contact_time(a: &Body, b: &Body, horizon: f64) -> Option<f64> {
         }
         let rel_v = (b.motion.com_velocity(s) - a.motion.com_velocity(s)).length();
         s += safe_step(d, rel_v + spin, gn);
+        if s > horizon {
+            return None;
+        }
+    }
+    Some(s)
+}
+
+/// Contact time of two bodies that touch at launch (signed distance `d0` <= 1 um).
+fn touching_pair_contact_time(a: &Body, b: &Body, d0: f64, horizon: f64) -> Option<f64> {
+    let g_rel = (b.motion.com_velocity(1.0) - b.motion.com_velocity(0.0))
+        - (a.motion.com_velocity(1.0) - a.motion.com_velocity(0.0));
+    let gn = g_rel.length();
+    let spin = a.motion.max_angular_speed() * a.radius + b.motion.max_angular_speed() * b.radius;
+    let sink_floor = d0.min(0.0) - TABLE_PENETRATION;
+    let mut left = false;
+    let mut s = 0.0;
+    for _ in 0..MAX_STEPS {
+        let (pa, qa) = a.motion.pose(s);
+        let (pb, qb) = b.motion.pose(s);
+        let d = signed_distance(a.shape, pa, qa, b.shape, pb, qb);
+        if !left && d > TABLE_LEAVE {
+            left = true;
+        }
+        let floor = if left { CONTACT_DISTANCE } else { sink_floor };
+        if d <= floor {
+            return Some(s);
+        }
+        let rel_v = (b.motion.com_velocity(s) - a.motion.com_velocity(s)).length();
+        s += safe_step(d - floor, rel_v + spin, gn).max(1e-9);
         if s > horizon {
             return None;
         }
@@ -341,6 +378,26 @@ pub fn table_contact_time(
     table_shape: &ContactShape,
     horizon: f64,
 ) -> Option<f64> {
+    table_contact(body, table, table_shape, horizon).map(|c| c.time)
+}
+
+/// A contact of a flying body with the table.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TableContact {
+    pub time: f64,
+    /// True for a landing (the body had left the table and came back down onto it);
+    /// false when it sank into the table before leaving it (launched downward, sliding,
+    /// or tipping a corner into it), which costs a contact but is no landing.
+    pub landed: bool,
+}
+
+/// As [`table_contact_time`], telling a landing from a sinking start.
+pub fn table_contact(
+    body: &Body,
+    table: &Table,
+    table_shape: &ContactShape,
+    horizon: f64,
+) -> Option<TableContact> {
     let flight = match body.motion {
         Motion::Flying(f) => f,
         Motion::Fixed { .. } => return None,
@@ -366,10 +423,11 @@ pub fn table_contact_time(
             -TABLE_PENETRATION
         };
         if d <= floor {
-            return Some(s);
+            // A landing is a body coming back down; a spinning body that clips the table
+            // while still rising is a contact, but no landing.
+            let landed = left && flight.com_velocity(s).z < 0.0;
+            return Some(TableContact { time: s, landed });
         }
-        // Cull by the bounding sphere: the body cannot be closer than its centre's
-        // distance minus its radius, which is cheap and often larger for far bodies.
         let v = flight.com_velocity(s).length();
         let step = safe_step(d - floor, v + spin, g).max(1e-9);
         s += step;
@@ -377,7 +435,10 @@ pub fn table_contact_time(
             return None;
         }
     }
-    Some(s)
+    Some(TableContact {
+        time: s,
+        landed: left && flight.com_velocity(s).z < 0.0,
+    })
 }
 
 /// Closed-form table contact of a ball that starts over the table's top face: its lowest
@@ -390,7 +451,7 @@ fn ball_table_closed_form(
     r: f64,
     table: &Table,
     horizon: f64,
-) -> Option<Option<f64>> {
+) -> Option<Option<TableContact>> {
     let over_top = |c: DVec3| {
         let d = (c - table.center).abs();
         d.x <= table.half_extents.x && d.y <= table.half_extents.y
@@ -437,7 +498,8 @@ fn ball_table_closed_form(
             // Going down through `level`: h'(s) = b + a s < 0 (or touching at the apex).
             .find(|&x| b + a * x <= 0.0)
     };
-    let answer = if h0 <= TABLE_LEAVE && b <= 0.0 && a <= 0.0 {
+    let sinks = h0 <= TABLE_LEAVE && b <= 0.0 && a <= 0.0;
+    let answer = if sinks {
         // Resting and not launched upward: it sinks at once.
         first_down(-TABLE_PENETRATION, 0.0)
     } else {
@@ -445,7 +507,10 @@ fn ball_table_closed_form(
     };
     match answer {
         Some(s) if s > horizon => Some(None),
-        Some(s) if over_top(f.com(s)) => Some(Some(s)),
+        Some(s) if over_top(f.com(s)) => Some(Some(TableContact {
+            time: s,
+            landed: !sinks,
+        })),
         Some(_) => None, // comes down past an edge of the top face
         None => Some(None),
     }
@@ -817,5 +882,149 @@ mod tests {
             }
         }
         assert!(landed > 100, "only {landed} landings exercised");
+    }
+
+    #[test]
+    fn bodies_touching_at_launch_only_collide_if_they_press_in_or_meet_again() {
+        let g = DVec3::new(0.0, 0.0, -9.81);
+        let s = Shape::Sphere { radius: 0.2 };
+        let shape = ContactShape::new(&s);
+        fn body<'a>(f: &'a FreeFlight, shape: &'a ContactShape) -> Body<'a> {
+            Body {
+                motion: Motion::Flying(f),
+                shape,
+                radius: 0.2,
+            }
+        }
+        // Touching, moving apart: no contact (it used to be reported at t = 0).
+        let a = flight(
+            &s,
+            DVec3::new(0.0, 0.0, 1.0),
+            DVec3::new(-1.0, 0.0, 3.0),
+            DVec3::ZERO,
+            g,
+            2.0,
+        );
+        let b = flight(
+            &s,
+            DVec3::new(0.4, 0.0, 1.0),
+            DVec3::new(1.0, 0.0, 3.0),
+            DVec3::ZERO,
+            g,
+            2.0,
+        );
+        assert_eq!(
+            pair_contact_time(&body(&a, &shape), &body(&b, &shape), 2.0),
+            None
+        );
+        // Touching, pressing into each other: a contact at once.
+        let c = flight(
+            &s,
+            DVec3::new(0.4, 0.0, 1.0),
+            DVec3::new(-1.0, 0.0, 3.0),
+            DVec3::ZERO,
+            g,
+            2.0,
+        );
+        let d = flight(
+            &s,
+            DVec3::new(0.0, 0.0, 1.0),
+            DVec3::new(1.0, 0.0, 3.0),
+            DVec3::ZERO,
+            g,
+            2.0,
+        );
+        let tc = pair_contact_time(&body(&c, &shape), &body(&d, &shape), 2.0)
+            .expect("pressing in is a contact");
+        assert!(tc < 1e-3, "{tc}");
+        // Boxes side by side, launched apart.
+        let bs = Shape::Cuboid {
+            half_extents: DVec3::splat(0.1),
+        };
+        let bshape = ContactShape::new(&bs);
+        let r = bs.bounding_radius(DVec3::ZERO);
+        let e = flight(
+            &bs,
+            DVec3::new(0.0, 0.0, 0.1),
+            DVec3::new(-4.0, 0.0, 3.0),
+            DVec3::ZERO,
+            g,
+            2.0,
+        );
+        let f = flight(
+            &bs,
+            DVec3::new(0.2, 0.0, 0.1),
+            DVec3::new(4.0, 0.0, 3.0),
+            DVec3::ZERO,
+            g,
+            2.0,
+        );
+        let be = Body {
+            motion: Motion::Flying(&e),
+            shape: &bshape,
+            radius: r,
+        };
+        let bf = Body {
+            motion: Motion::Flying(&f),
+            shape: &bshape,
+            radius: r,
+        };
+        assert_eq!(pair_contact_time(&be, &bf, 2.0), None);
+    }
+
+    #[test]
+    fn a_spinning_box_tipping_into_the_table_is_a_contact_but_no_landing() {
+        let g = DVec3::new(0.0, 0.0, -9.81);
+        let s = Shape::Cuboid {
+            half_extents: DVec3::new(0.3, 0.2, 0.1),
+        };
+        let table = Table {
+            center: DVec3::new(0.0, 0.0, -0.5),
+            half_extents: DVec3::new(10.0, 10.0, 0.5),
+        };
+        let ts = table_shape(&table);
+        let shape = ContactShape::new(&s);
+        let r = s.bounding_radius(DVec3::ZERO);
+        let f = flight(
+            &s,
+            DVec3::new(0.0, 0.0, 0.1),
+            DVec3::new(0.0, 0.0, 7.0),
+            DVec3::new(60.0, 0.0, 0.0),
+            g,
+            2.0,
+        );
+        let c = table_contact(
+            &Body {
+                motion: Motion::Flying(&f),
+                shape: &shape,
+                radius: r,
+            },
+            &table,
+            &ts,
+            2.0,
+        )
+        .unwrap();
+        assert!(c.time < 0.01 && !c.landed, "{c:?}");
+        // Thrown up without spin, it lands: a landing.
+        let f = flight(
+            &s,
+            DVec3::new(0.0, 0.0, 0.1),
+            DVec3::new(0.0, 0.0, 4.0),
+            DVec3::ZERO,
+            g,
+            2.0,
+        );
+        let c = table_contact(
+            &Body {
+                motion: Motion::Flying(&f),
+                shape: &shape,
+                radius: r,
+            },
+            &table,
+            &ts,
+            2.0,
+        )
+        .unwrap();
+        assert!(c.landed && (c.time - 8.0 / 9.81).abs() < 1e-5, "{c:?}");
     }
 }

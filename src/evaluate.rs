@@ -30,6 +30,10 @@ use crate::mask::Mask;
 use crate::raster::RasterScratch;
 use crate::scene::Scene;
 
+/// Largest total rotation (rad) of a launched body by `t` that a sample may ask for; more
+/// (over 300 turns) is treated as a diverged sample.
+pub const MAX_TURN: f64 = 2000.0;
+
 /// Contacts closer together in time than this (s) are counted as one event's contacts.
 const SIMULTANEOUS: f64 = 1e-6;
 
@@ -52,7 +56,10 @@ pub struct Workspace {
     world_vertices: Vec<DVec3>,
     /// Pose of every occluder at `t` (body origin, orientation), from the last sample.
     pub poses: Vec<(DVec3, DQuat)>,
+    /// Time of each body's landing on the table (it stays there), if before t.
     landing: Vec<Option<f64>>,
+    /// Time of each body's first table contact (a landing or sinking in), if before t.
+    table_hit: Vec<Option<f64>>,
 }
 
 /// What happened in flight.
@@ -156,6 +163,7 @@ impl Problem {
             world_vertices: Vec::with_capacity(max_vertices),
             poses: vec![(DVec3::ZERO, DQuat::IDENTITY); n],
             landing: vec![None; n],
+            table_hit: vec![None; n],
         }
     }
 
@@ -163,7 +171,7 @@ impl Problem {
     /// non-launched occluders are ignored. Terms with weight 0 are skipped.
     pub fn evaluate(&self, params: &[f64], weights: &Weights, ws: &mut Workspace) -> Evaluation {
         debug_assert_eq!(params.len(), self.scene.variable_count());
-        if params.iter().any(|x| !x.is_finite()) {
+        if params.iter().any(|x| !x.is_finite()) || self.spins_too_fast(params) {
             return Evaluation::diverged();
         }
         let outcome = self.fly(params, ws);
@@ -179,6 +187,14 @@ impl Problem {
             outcome,
             iou,
         }
+    }
+
+    /// Whether a launched body would turn more than [`MAX_TURN`] radians by `t`: no real
+    /// launch does, and the asymmetric-body integrator's step grid grows with the turn.
+    fn spins_too_fast(&self, params: &[f64]) -> bool {
+        self.scene.occluders.iter().enumerate().any(|(i, o)| {
+            o.launched && launch_velocities(params, i).1.length() * self.scene.t > MAX_TURN
+        })
     }
 
     /// Steps 1-3: flights, first contact, poses at `t` (into `ws.poses`).
@@ -201,26 +217,38 @@ impl Problem {
             }
         }
         let outcome = self.first_contact(ws);
-        for (i, o) in scene.occluders.iter().enumerate() {
-            ws.poses[i] = if !o.launched {
-                (o.position, o.orientation)
-            } else {
-                let f = &ws.flights[i];
-                let q = f.orientation(t);
-                let com = match ws.landing[i] {
-                    // Landed before t: the table absorbs the vertical motion; the body
-                    // slides on with its horizontal velocity from the landing.
-                    Some(tl) if tl < t => {
-                        let mut vh = f.com_velocity(tl);
-                        vh.z = 0.0;
-                        f.com(tl) + vh * (t - tl)
-                    }
-                    _ => f.com(t),
-                };
-                (com - q * o.mass.local_com, q)
-            };
+        for i in 0..scene.occluders.len() {
+            ws.poses[i] = self.state_at(ws, i, t).0;
         }
         outcome
+    }
+
+    /// State of occluder `i` at `time` (0 <= time <= t) in the solver's model, after
+    /// [`Problem::fly`] has run on `ws`: ((body origin, orientation), (centre-of-mass
+    /// velocity, angular velocity)). A body that has landed stays on the table: the table
+    /// absorbs its vertical motion and it slides on with its horizontal velocity.
+    pub fn state_at(
+        &self,
+        ws: &Workspace,
+        i: usize,
+        time: f64,
+    ) -> ((DVec3, DQuat), (DVec3, DVec3)) {
+        let o = &self.scene.occluders[i];
+        if !o.launched {
+            return ((o.position, o.orientation), (DVec3::ZERO, DVec3::ZERO));
+        }
+        let f = &ws.flights[i];
+        let q = f.orientation(time);
+        let w = f.angular_velocity(time);
+        let (com, v) = match ws.landing[i] {
+            Some(tl) if tl < time => {
+                let mut vh = f.com_velocity(tl);
+                vh.z = 0.0;
+                (f.com(tl) + vh * (time - tl), vh)
+            }
+            _ => (f.com(time), f.com_velocity(time)),
+        };
+        ((com - q * o.mass.local_com, q), (v, w))
     }
 
     fn motion<'a>(&self, i: usize, ws: &'a Workspace) -> Motion<'a> {
@@ -246,6 +274,7 @@ impl Problem {
         // searched over the whole flight.
         for i in 0..n {
             ws.landing[i] = None;
+            ws.table_hit[i] = None;
             if !scene.occluders[i].launched {
                 continue;
             }
@@ -255,11 +284,15 @@ impl Problem {
                     shape: &self.shapes[i],
                     radius: scene.occluders[i].bounding_radius,
                 };
-                let tl = contact::table_contact_time(&body, table, ts, t);
-                ws.landing[i] = tl;
-                if let Some(tl) = tl {
-                    if tl < best {
-                        best = tl;
+                let c = contact::table_contact(&body, table, ts, t);
+                // Only a real landing stops the body; sinking into the table before
+                // leaving it (a spinning box tipping a corner in) costs a contact, but the
+                // body flies on, so its launch speed still shapes its shadow at t.
+                ws.landing[i] = c.filter(|c| c.landed).map(|c| c.time);
+                ws.table_hit[i] = c.map(|c| c.time);
+                if let Some(c) = c {
+                    if c.time < best {
+                        best = c.time;
                         first = Some((i, None));
                     }
                 }
@@ -305,7 +338,12 @@ impl Problem {
             };
         }
         let cut = best + SIMULTANEOUS;
-        let mut count = ws.landing.iter().flatten().filter(|&&tl| tl <= cut).count() as u32;
+        let mut count = ws
+            .table_hit
+            .iter()
+            .flatten()
+            .filter(|&&tl| tl <= cut)
+            .count() as u32;
         count += pair_hits.iter().filter(|&&tc| tc <= cut).count() as u32;
         // More than 64 pair hits within one horizon is not realistic; count the overflow
         // as simultaneous, which only raises the penalty.

@@ -17,13 +17,13 @@ use crate::solver::{SampleRecord, Solution};
 /// Why an output could not be written or read.
 #[derive(Debug, thiserror::Error)]
 pub enum ExportError {
-    #[error("cannot write {path}: {source}")]
+    #[error("cannot write {path}")]
     Write {
         path: PathBuf,
         #[source]
         source: std::io::Error,
     },
-    #[error("cannot read {path}: {source}")]
+    #[error("cannot read {path}")]
     Read {
         path: PathBuf,
         #[source]
@@ -173,6 +173,20 @@ pub fn write_convergence(
     };
     let img = picture::convergence_plot(&data, 520, 380);
     save_png(&img, &dir.join("convergence.png"))
+}
+
+/// Write rows as a CSV file (header from the field names), atomically.
+pub fn write_csv<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<()> {
+    let enc = |message: String| ExportError::Encode {
+        path: path.to_path_buf(),
+        message,
+    };
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for r in rows {
+        w.serialize(r).map_err(|e| enc(e.to_string()))?;
+    }
+    let bytes = w.into_inner().map_err(|e| enc(e.to_string()))?;
+    write_atomic(path, &bytes)
 }
 
 /// Read `convergence.csv` back (for `--resume`), keeping the rows of stages below `stages`.

@@ -28,7 +28,7 @@ use crate::raster::ShadowCamera;
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The scene file (or a file it names) could not be read.
-    #[error("cannot read {path}: {source}")]
+    #[error("cannot read {path}")]
     Io {
         path: PathBuf,
         #[source]
@@ -51,7 +51,7 @@ pub enum SceneError {
     #[error("{path}: the target image has no dark pixel (dark = luminance below half, opaque); there is nothing to match")]
     TargetEmpty { path: PathBuf },
     /// An OBJ mesh could not be used.
-    #[error("{path}: field `{field}`: {source}")]
+    #[error("{path}: field `{field}`: unusable mesh")]
     Obj {
         path: PathBuf,
         field: String,
@@ -357,6 +357,11 @@ impl Scene {
     }
 }
 
+/// Largest target image side (pixels).
+pub const MAX_IMAGE_SIDE: usize = 16384;
+/// Largest CMA-ES population a stage may ask for.
+pub const MAX_POPULATION: usize = 100_000;
+
 /// Default simulation timestep (s), as in the paper.
 pub const DEFAULT_TIMESTEP: f64 = 1.0 / 60.0;
 /// Default gravity (m/s^2), Z up.
@@ -465,7 +470,7 @@ impl Validator<'_> {
 
     fn scene(&self, raw: RawScene, default_name: String) -> Result<Scene> {
         let name = raw.name.clone().unwrap_or(default_name);
-        if name.is_empty() || name.contains(['/', '\\']) {
+        if name.is_empty() || name == "." || name == ".." || name.contains(['/', '\\']) {
             return Err(self.field_err("name", "must be a non-empty name without path separators"));
         }
         let t = self.positive("t", raw.t)?;
@@ -629,6 +634,12 @@ impl Validator<'_> {
             })?
             .to_rgba8();
         let (w, h) = (img.width() as usize, img.height() as usize);
+        if w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE {
+            return Err(SceneError::TargetNotPng {
+                path,
+                reason: format!("{w} x {h} pixels is larger than the {MAX_IMAGE_SIDE} x {MAX_IMAGE_SIDE} supported"),
+            });
+        }
         let mask = Mask::from_fn(w, h, |x, y| {
             let p = img.get_pixel(x as u32, y as u32).0;
             // Rec. 709 luma of the 8-bit values; dark means below half luminance, and a
@@ -709,7 +720,12 @@ impl Validator<'_> {
                 )
             }
         };
-        let mass = shape.mass_properties(density);
+        let mass = shape.mass_properties_checked(density).ok_or_else(|| {
+            self.field_err(
+                f("shape"),
+                "is too small or too large to give a finite, positive mass and inertia",
+            )
+        })?;
         let launched = ro.launched.unwrap_or(true);
         // The default start guess launches straight up so that the centre of mass is
         // `rise` metres higher at t: a neutral, collision-free, in-view starting point.
@@ -910,8 +926,11 @@ impl Validator<'_> {
         let population = rs
             .population
             .unwrap_or(4 + (3.0 * (n as f64).ln()).floor() as usize);
-        if population < 4 {
-            return Err(self.field_err(format!("{field}.population"), "must be at least 4"));
+        if !(4..=MAX_POPULATION).contains(&population) {
+            return Err(self.field_err(
+                format!("{field}.population"),
+                format!("must be between 4 and {MAX_POPULATION}"),
+            ));
         }
         let target_energy = match rs.target_energy {
             Some(x) => Some(self.finite(&format!("{field}.target_energy"), x)?),
@@ -1061,7 +1080,11 @@ fn aim_at_hints(
         let s = h / light_height;
         let hint_at_t = on_plane + s * (camera.light - on_plane);
         let com_t = hint_at_t - offset;
-        o.start_velocity = (com_t - com0 - 0.5 * gravity * t * t) / t;
+        let v = (com_t - com0 - 0.5 * gravity * t * t) / t;
+        // Absurd hint values can overflow; keep the straight-up start then.
+        if v.is_finite() {
+            o.start_velocity = v;
+        }
     }
 }
 

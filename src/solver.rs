@@ -119,6 +119,10 @@ pub struct StageReport {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Solution {
     pub scene: String,
+    /// The scene file the solution was made from (absolute when known); `export`,
+    /// `validate` and `video` find the scene through it unless told otherwise.
+    #[serde(default)]
+    pub scene_file: Option<String>,
     pub seed: u64,
     pub t: f64,
     pub stages_total: usize,
@@ -261,9 +265,12 @@ fn stage_seed(seed: u64, k: usize) -> u64 {
     z ^ (z >> 31)
 }
 
-fn stop_name(s: Option<StopReason>, interrupted: bool) -> String {
+fn stop_name(s: Option<StopReason>, interrupted: bool, stopped: bool) -> String {
+    if stopped {
+        return "stopped (Ctrl-C twice)".into();
+    }
     if interrupted {
-        return "interrupted".into();
+        return "interrupted (Ctrl-C: next stage)".into();
     }
     match s {
         Some(StopReason::TargetReached) => "target energy reached",
@@ -298,11 +305,13 @@ pub fn solve(
     let start = Instant::now();
 
     let (mut params, first_stage, mut records, mut reports, prior_time) = match &options.resume {
+        // Reports of a stage that a stop cut short are dropped: that stage runs again,
+        // starting from the saved best.
         Some(s) => (
             s.parameters(),
             s.stages_completed,
             Vec::new(),
-            s.stages.clone(),
+            s.stages[..s.stages_completed.min(s.stages.len())].to_vec(),
             s.wall_time_s,
         ),
         None => (scene.start_parameters(), 0, Vec::new(), Vec::new(), 0.0),
@@ -409,6 +418,9 @@ pub fn solve(
             }
         };
         params.copy_from_slice(&best_params);
+        // A second interrupt during the stage stops the solve: the stage does not count
+        // as completed, so that `--resume` runs it again from the best so far.
+        let stopped = interrupted && interrupts.load(Ordering::SeqCst) >= 2;
         reports.push(StageReport {
             name: stage.name.clone(),
             iterations: iteration,
@@ -416,7 +428,7 @@ pub fn solve(
             population: lambda,
             best_energy: best_eval.total,
             iou: best_eval.iou,
-            stop: stop_name(stop, interrupted),
+            stop: stop_name(stop, interrupted, stopped),
             wall_time_s: stage_start.elapsed().as_secs_f64(),
         });
         let wall = prior_time + start.elapsed().as_secs_f64();
@@ -424,7 +436,7 @@ pub fn solve(
             problem,
             seed,
             &params,
-            k + 1,
+            if stopped { k } else { k + 1 },
             &reports,
             wall,
             threads,
@@ -432,16 +444,23 @@ pub fn solve(
             None,
         );
         observer.stage_finished(&s, &records);
-        if interrupted && interrupts.load(Ordering::SeqCst) >= 2 {
+        if stopped {
             aborted = true;
             break;
         }
     }
-    let completed = reports.len();
+    // A stage cut short by a stop is reported but not completed.
+    let completed = reports.len()
+        - usize::from(
+            aborted
+                && reports
+                    .last()
+                    .is_some_and(|r| r.stop.starts_with("stopped")),
+        );
     let wall = prior_time + start.elapsed().as_secs_f64();
     let complete = !aborted
         && completed == scene.stages.len()
-        && reports.iter().all(|r| r.stop != "interrupted");
+        && reports.iter().all(|r| !r.stop.starts_with("interrupted"));
     let mut ws = problem.workspace();
     let timing = problem.profile(&params, 200, &mut ws);
     let s = summarize(
@@ -499,6 +518,12 @@ pub fn summarize(
         .collect();
     Solution {
         scene: scene.name.clone(),
+        scene_file: Some(
+            std::path::absolute(&scene.source)
+                .unwrap_or_else(|_| scene.source.clone())
+                .display()
+                .to_string(),
+        ),
         seed,
         t: scene.t,
         stages_total: scene.stages.len(),

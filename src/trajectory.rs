@@ -1,0 +1,255 @@
+//! The whole motion of a solution, for animation and for building it: [`Track`] (poses of
+//! every occluder at every timestep) and [`LaunchRow`] (one row of `launch.csv` per
+//! occluder).
+//!
+//! Data flow of [`track`]: from launch to `t` the poses come from the solver's own model
+//! ([`Problem::fly`] and [`Problem::state_at`]: exact free flight, landings absorbed by the
+//! table), with a key at every timestep and one exactly at `t`, so that the animation
+//! shows at `t` exactly the shadow the solver scored. From `t` on, rapier3d continues the
+//! motion with collisions, landing and bouncing ([`crate::continuation`]), by default for
+//! one second.
+
+use glam::{DQuat, DVec3};
+use serde::Serialize;
+
+use crate::body::Shape;
+use crate::continuation::{self, BodyState, ContinuationConfig};
+use crate::evaluate::{launch_velocities, Problem};
+
+/// Poses at every key: `poses[k][i]` is occluder `i` at `times[k]` (body origin,
+/// body -> world orientation, Z-up world).
+#[derive(Clone, Debug, Default)]
+pub struct Track {
+    pub times: Vec<f64>,
+    pub poses: Vec<Vec<(DVec3, DQuat)>>,
+    /// Index of the key at exactly `t`.
+    pub t_index: usize,
+    /// 1 / timestep.
+    pub fps: f64,
+    /// Keys from `t_index` on come from the rapier continuation.
+    pub continuation_from: usize,
+}
+
+/// Default length of the continuation after `t` (s).
+pub const DEFAULT_AFTER: f64 = 1.0;
+
+/// The motion of launch values `params` from 0 to `t + after`.
+pub fn track(problem: &Problem, params: &[f64], after: f64) -> Track {
+    let scene = &problem.scene;
+    let (t, dt) = (scene.t, scene.dt);
+    let n = scene.occluders.len();
+    let mut ws = problem.workspace();
+    problem.fly(params, &mut ws);
+    let mut out = Track {
+        fps: 1.0 / dt,
+        ..Track::default()
+    };
+    // Keys at every step before t; a step closer than a thousandth of a step to t is
+    // replaced by the key at t itself.
+    let mut k = 0usize;
+    loop {
+        let time = k as f64 * dt;
+        if time >= t - 1e-3 * dt {
+            break;
+        }
+        out.times.push(time);
+        out.poses
+            .push((0..n).map(|i| problem.state_at(&ws, i, time).0).collect());
+        k += 1;
+    }
+    let start: Vec<BodyState> = (0..n)
+        .map(|i| {
+            let ((origin, orientation), (velocity, angular_velocity)) = problem.state_at(&ws, i, t);
+            BodyState {
+                origin,
+                orientation,
+                velocity,
+                angular_velocity,
+            }
+        })
+        .collect();
+    let steps = (after / dt).round().max(0.0) as usize;
+    let frames = continuation::simulate(scene, &start, t, steps, &ContinuationConfig::default());
+    out.t_index = out.times.len();
+    out.continuation_from = out.t_index;
+    for (time, poses) in frames.times.into_iter().zip(frames.poses) {
+        out.times.push(time);
+        out.poses.push(poses);
+    }
+    // Frame 0 of the continuation is the start state itself: the exact pose at t.
+    out.poses[out.t_index] = start.iter().map(|s| (s.origin, s.orientation)).collect();
+    out
+}
+
+/// One row of `launch.csv`: everything a builder needs to launch one occluder. Column
+/// names carry their units.
+#[derive(Clone, Debug, Serialize)]
+pub struct LaunchRow {
+    pub name: String,
+    pub shape: String,
+    pub launched: bool,
+    pub mass_kg: f64,
+    /// Centre-of-mass position at launch (m).
+    pub com_x_m: f64,
+    pub com_y_m: f64,
+    pub com_z_m: f64,
+    /// Orientation at launch, body -> world (unit quaternion).
+    pub qx: f64,
+    pub qy: f64,
+    pub qz: f64,
+    pub qw: f64,
+    /// Centre-of-mass launch velocity (m/s).
+    pub vx_m_s: f64,
+    pub vy_m_s: f64,
+    pub vz_m_s: f64,
+    pub speed_m_s: f64,
+    /// Angle above the horizontal (deg).
+    pub elevation_deg: f64,
+    /// Direction in the horizontal plane, from +x toward +y (deg).
+    pub azimuth_deg: f64,
+    /// Launch angular velocity, world frame (rad/s).
+    pub wx_rad_s: f64,
+    pub wy_rad_s: f64,
+    pub wz_rad_s: f64,
+    pub spin_rev_s: f64,
+    /// Spin axis in the body frame (unit; zero without spin).
+    pub spin_axis_body_x: f64,
+    pub spin_axis_body_y: f64,
+    pub spin_axis_body_z: f64,
+    /// Principal moments of inertia about the centre of mass (kg m^2).
+    pub inertia_1_kg_m2: f64,
+    pub inertia_2_kg_m2: f64,
+    pub inertia_3_kg_m2: f64,
+    /// Centre of mass in the body frame (m).
+    pub com_offset_x_m: f64,
+    pub com_offset_y_m: f64,
+    pub com_offset_z_m: f64,
+    /// Predicted centre-of-mass position at t (m).
+    pub com_at_t_x_m: f64,
+    pub com_at_t_y_m: f64,
+    pub com_at_t_z_m: f64,
+    /// Predicted orientation at t (body -> world).
+    pub q_at_t_x: f64,
+    pub q_at_t_y: f64,
+    pub q_at_t_z: f64,
+    pub q_at_t_w: f64,
+}
+
+/// The launch table of launch values `params`.
+pub fn launch_rows(problem: &Problem, params: &[f64]) -> Vec<LaunchRow> {
+    let scene = &problem.scene;
+    let mut ws = problem.workspace();
+    problem.fly(params, &mut ws);
+    scene
+        .occluders
+        .iter()
+        .enumerate()
+        .map(|(i, o)| {
+            let (v, w) = if o.launched {
+                launch_velocities(params, i)
+            } else {
+                (DVec3::ZERO, DVec3::ZERO)
+            };
+            let com = o.launch_com();
+            let speed = v.length();
+            let horizontal = v.truncate().length();
+            let axis = if w.length() > 0.0 {
+                (o.orientation.inverse() * w).normalize()
+            } else {
+                DVec3::ZERO
+            };
+            let ((p_t, q_t), _) = problem.state_at(&ws, i, scene.t);
+            let com_t = p_t + q_t * o.mass.local_com;
+            let shape = match &o.shape {
+                Shape::Sphere { radius } => format!("sphere r={radius}"),
+                Shape::Cuboid { half_extents: h } => {
+                    format!("box {}x{}x{}", 2.0 * h.x, 2.0 * h.y, 2.0 * h.z)
+                }
+                Shape::Mesh(m) => format!("mesh {} triangles", m.triangles.len()),
+            };
+            LaunchRow {
+                name: o.name.clone(),
+                shape,
+                launched: o.launched,
+                mass_kg: o.mass.mass,
+                com_x_m: com.x,
+                com_y_m: com.y,
+                com_z_m: com.z,
+                qx: o.orientation.x,
+                qy: o.orientation.y,
+                qz: o.orientation.z,
+                qw: o.orientation.w,
+                vx_m_s: v.x,
+                vy_m_s: v.y,
+                vz_m_s: v.z,
+                speed_m_s: speed,
+                elevation_deg: v.z.atan2(horizontal).to_degrees(),
+                azimuth_deg: v.y.atan2(v.x).to_degrees(),
+                wx_rad_s: w.x,
+                wy_rad_s: w.y,
+                wz_rad_s: w.z,
+                spin_rev_s: w.length() / std::f64::consts::TAU,
+                spin_axis_body_x: axis.x,
+                spin_axis_body_y: axis.y,
+                spin_axis_body_z: axis.z,
+                inertia_1_kg_m2: o.mass.principal_inertia.x,
+                inertia_2_kg_m2: o.mass.principal_inertia.y,
+                inertia_3_kg_m2: o.mass.principal_inertia.z,
+                com_offset_x_m: o.mass.local_com.x,
+                com_offset_y_m: o.mass.local_com.y,
+                com_offset_z_m: o.mass.local_com.z,
+                com_at_t_x_m: com_t.x,
+                com_at_t_y_m: com_t.y,
+                com_at_t_z_m: com_t.z,
+                q_at_t_x: q_t.x,
+                q_at_t_y: q_t.y,
+                q_at_t_z: q_t.z,
+                q_at_t_w: q_t.w,
+            }
+        })
+        .collect()
+}
+
+/// One row of `trajectory.csv`: one occluder's pose at one key.
+#[derive(Clone, Debug, Serialize)]
+pub struct TrajectoryRow {
+    pub time_s: f64,
+    pub occluder: String,
+    /// `flight` (the solver's exact model, up to and including t) or `continuation` (rapier, after t).
+    pub phase: &'static str,
+    /// Body-frame origin (m).
+    pub x_m: f64,
+    pub y_m: f64,
+    pub z_m: f64,
+    /// Body -> world orientation.
+    pub qx: f64,
+    pub qy: f64,
+    pub qz: f64,
+    pub qw: f64,
+}
+
+/// The rows of `trajectory.csv` for a track.
+pub fn trajectory_rows(problem: &Problem, tr: &Track) -> Vec<TrajectoryRow> {
+    let mut rows = Vec::with_capacity(tr.times.len() * problem.scene.occluders.len());
+    for (k, (time, poses)) in tr.times.iter().zip(&tr.poses).enumerate() {
+        for (o, (p, q)) in problem.scene.occluders.iter().zip(poses) {
+            rows.push(TrajectoryRow {
+                time_s: *time,
+                occluder: o.name.clone(),
+                phase: if k <= tr.t_index {
+                    "flight"
+                } else {
+                    "continuation"
+                },
+                x_m: p.x,
+                y_m: p.y,
+                z_m: p.z,
+                qx: q.x,
+                qy: q.y,
+                qz: q.z,
+                qw: q.w,
+            });
+        }
+    }
+    rows
+}
