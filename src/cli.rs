@@ -149,7 +149,9 @@ pub fn run(cli: Cli) -> Result<()> {
             if !(after.is_finite() && after >= 0.0) {
                 bail!("--after must be a non-negative number of seconds, got {after}");
             }
-            write_exports(&dir, &problem, &solution, after)
+            let msg = write_exports(&dir, &problem, &solution, after)?;
+            println!("{msg}");
+            Ok(())
         }
         Command::Validate { dir, scene, python } => validate(&dir, scene.as_deref(), python),
         Command::Video {
@@ -428,7 +430,7 @@ fn solve(
     problem.evaluate(&params, &Weights::all_ones(), &mut ws);
     export::write_pictures(&out, &scene.target, &ws.mask)?;
     export::write_preview(&out, &scene.target, &ws.mask)?;
-    write_exports(&out, &problem, &solution, crate::trajectory::DEFAULT_AFTER)?;
+    let exported = write_exports(&out, &problem, &solution, crate::trajectory::DEFAULT_AFTER)?;
     println!(
         "{}: IoU at t {:.4}, {} before t ({} contacts), {} samples in {} iterations, {:.2} s on {} threads{}",
         scene.name,
@@ -445,7 +447,7 @@ fn solve(
         solution.threads,
         if solution.complete { "" } else { " (stopped early)" }
     );
-    println!("wrote {}", out.display());
+    println!("{exported}");
     if report {
         print_report(&solution);
     }
@@ -483,8 +485,8 @@ fn load_solution_dir(dir: &Path, scene: Option<&Path>) -> Result<(Problem, Solut
     Ok((problem, solution))
 }
 
-/// `<scene>.glb`, `launch.csv` and `trajectory.csv`.
-fn write_exports(dir: &Path, problem: &Problem, solution: &Solution, after: f64) -> Result<()> {
+/// `<scene>.glb`, `launch.csv` and `trajectory.csv`; returns a one-line summary.
+fn write_exports(dir: &Path, problem: &Problem, solution: &Solution, after: f64) -> Result<String> {
     let params = solution.parameters();
     let track = crate::trajectory::track(problem, &params, after);
     let name = &problem.scene.name;
@@ -505,14 +507,13 @@ fn write_exports(dir: &Path, problem: &Problem, solution: &Solution, after: f64)
         &dir.join("trajectory.csv"),
         &crate::trajectory::trajectory_rows(problem, &track),
     )?;
-    println!(
+    Ok(format!(
         "wrote {}/{{{name}.glb, launch.csv, trajectory.csv}}: {} keys, t = {} s at key {}",
         dir.display(),
         track.times.len(),
         problem.scene.t,
         track.t_index
-    );
-    Ok(())
+    ))
 }
 
 /// The Python interpreter that has `bpy`: `--python`, else `$BSA_PYTHON`, else
