@@ -197,10 +197,9 @@ impl Problem {
         })
     }
 
-    /// Steps 1-3: flights, first contact, poses at `t` (into `ws.poses`).
-    pub fn fly(&self, params: &[f64], ws: &mut Workspace) -> Outcome {
+    /// Step 1: start the exact free flight of every launched body.
+    fn launch(&self, params: &[f64], ws: &mut Workspace) {
         let scene = &self.scene;
-        let t = scene.t;
         for (i, o) in scene.occluders.iter().enumerate() {
             if o.launched {
                 let (v, w) = launch_velocities(params, i);
@@ -211,11 +210,18 @@ impl Problem {
                     v,
                     w,
                     scene.gravity,
-                    t,
+                    scene.t,
                     &self.flight,
                 );
             }
         }
+    }
+
+    /// Steps 1-3: flights, first contact, poses at `t` (into `ws.poses`).
+    pub fn fly(&self, params: &[f64], ws: &mut Workspace) -> Outcome {
+        let scene = &self.scene;
+        let t = scene.t;
+        self.launch(params, ws);
         let outcome = self.first_contact(ws);
         for i in 0..scene.occluders.len() {
             ws.poses[i] = self.state_at(ws, i, t).0;
@@ -437,24 +443,7 @@ impl Problem {
             }
             start.elapsed().as_secs_f64() * 1e6 / reps as f64
         };
-        let scene = &self.scene;
-        let us = time(&mut || {
-            for (i, o) in scene.occluders.iter().enumerate() {
-                if o.launched {
-                    let (v, w) = launch_velocities(params, i);
-                    ws.flights[i].reset(
-                        &o.mass,
-                        o.position,
-                        o.orientation,
-                        v,
-                        w,
-                        scene.gravity,
-                        scene.t,
-                        &self.flight,
-                    );
-                }
-            }
-        });
+        let us = time(&mut || self.launch(params, ws));
         out.push(("flight".into(), us));
         let us = time(&mut || {
             std::hint::black_box(self.first_contact(ws));
