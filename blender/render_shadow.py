@@ -17,7 +17,6 @@ Shadow pixel = alpha > 0.5 and Rec. 709 luma < 0.5.
 """
 
 import argparse
-import json
 import os
 import sys
 import tempfile
@@ -234,7 +233,7 @@ def main():
         "seconds": timer(),
         "warnings": warnings,
     }
-    print(B.RESULT_PREFIX + json.dumps(summary), flush=True)
+    B.result(summary)
 
 
 if __name__ == "__main__":

@@ -13,7 +13,6 @@ Prints one line `BSA_RESULT {"video": ..., "frames": [a, b], "bytes": N, ...}` o
 """
 
 import argparse
-import json
 import math
 import os
 import shutil
@@ -209,10 +208,10 @@ def main():
         scene.frame_set(a)
         t0 = timer()
         bpy.ops.render.render(write_still=True)
-        print(B.RESULT_PREFIX + json.dumps({
+        B.result({
             "still": out, "frame": a, "bytes": os.path.getsize(out),
             "light_energy_w": round(ld.energy, 3), "render_seconds": round(timer() - t0, 3),
-            "seconds": timer(), "warnings": warnings}), flush=True)
+            "seconds": timer(), "warnings": warnings})
         return
 
     # Video output. bpy 5.0: media_type BEFORE file_format.
@@ -266,7 +265,7 @@ def main():
         "seconds": timer(),
         "warnings": warnings,
     }
-    print(B.RESULT_PREFIX + json.dumps(summary), flush=True)
+    B.result(summary)
 
 
 if __name__ == "__main__":
