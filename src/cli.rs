@@ -122,6 +122,10 @@ enum Command {
         /// Print JSON instead of a table.
         #[arg(long)]
         json: bool,
+        /// Also time each phase of one sample on one core (microseconds, averaged over
+        /// this many repetitions), as the paper's Table 4.
+        #[arg(long, value_name = "REPS")]
+        profile: Option<usize>,
     },
 }
 
@@ -143,7 +147,8 @@ pub fn run(cli: Cli) -> Result<()> {
             solution,
             stage,
             json,
-        } => eval(&scene, &solution, stage, json),
+            profile,
+        } => eval(&scene, &solution, stage, json, profile),
         Command::Export { dir, scene, after } => {
             let (problem, solution) = load_solution_dir(&dir, scene.as_deref())?;
             if !(after.is_finite() && after >= 0.0) {
@@ -260,6 +265,21 @@ fn check(path: &Path) -> Result<()> {
         );
     }
     println!("  seed     {}", s.seed);
+    // The start guess is where every stage's search begins: say how it looks, and name a
+    // contact in it, since a start that collides is a slow start.
+    let problem = Problem::new(s.clone());
+    let mut ws = problem.workspace();
+    let e = problem.evaluate(&s.start_parameters(), &Weights::all_ones(), &mut ws);
+    match e.outcome.first_contact {
+        Some((i, j)) => println!(
+            "  start    IoU at t {:.4}; first contact at {:.4} s: `{}` with `{}`",
+            e.iou,
+            e.outcome.t_sim,
+            s.occluders[i].name,
+            j.map_or("table", |j| s.occluders[j].name.as_str())
+        ),
+        None => println!("  start    IoU at t {:.4}; no contact before t", e.iou),
+    }
     println!("ok");
     Ok(())
 }
@@ -743,7 +763,13 @@ fn print_report(s: &Solution) {
     }
 }
 
-fn eval(scene_path: &Path, solution_path: &Path, stage: Option<usize>, json: bool) -> Result<()> {
+fn eval(
+    scene_path: &Path,
+    solution_path: &Path,
+    stage: Option<usize>,
+    json: bool,
+    profile: Option<usize>,
+) -> Result<()> {
     let scene = load_scene(scene_path)?;
     let problem = Problem::new(scene);
     let s = export::read_solution(solution_path)?;
@@ -771,6 +797,15 @@ fn eval(scene_path: &Path, solution_path: &Path, stage: Option<usize>, json: boo
             (t, raw, w, raw * w)
         })
         .collect();
+    let first_contact = e.outcome.first_contact.map(|(i, j)| {
+        let a = scene.occluders[i].name.clone();
+        let b = j.map_or_else(|| "table".to_string(), |j| scene.occluders[j].name.clone());
+        (a, b)
+    });
+    let timings = match profile {
+        Some(reps) => problem.profile(&s.parameters(), reps.max(1), &mut ws),
+        None => Vec::new(),
+    };
     if json {
         let terms: serde_json::Map<String, serde_json::Value> = rows
             .iter()
@@ -789,6 +824,8 @@ fn eval(scene_path: &Path, solution_path: &Path, stage: Option<usize>, json: boo
             "iou": e.iou,
             "t_sim": e.outcome.t_sim,
             "n_contacts": e.outcome.n_contacts,
+            "first_contact": first_contact.as_ref().map(|(a, b)| [a, b]),
+            "time_per_phase_us": timings.iter().map(|(k, v)| (k.clone(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
         });
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
@@ -810,6 +847,15 @@ fn eval(scene_path: &Path, solution_path: &Path, stage: Option<usize>, json: boo
             "IoU at t {:.5}; t_sim {:.5} s; contacts {}",
             e.iou, e.outcome.t_sim, e.outcome.n_contacts
         );
+        if let Some((a, b)) = &first_contact {
+            println!("first contact: `{a}` with `{b}`");
+        }
+        if !timings.is_empty() {
+            println!("time per sample phase (one core, microseconds):");
+            for (k, v) in &timings {
+                println!("  {k:<26} {v:>10.2}");
+            }
+        }
     }
     Ok(())
 }

@@ -29,10 +29,18 @@ use rapier3d::parry::query;
 use rapier3d::parry::shape::{Ball, ConvexPolyhedron, Cuboid, Shape as ParryShape};
 
 use crate::body::{FreeFlight, Shape};
+use crate::gjk::{Polytope, Warm};
 use crate::scene::{Occluder, Table};
 
 /// Surfaces closer than this (m) are in contact.
 pub const CONTACT_DISTANCE: f64 = 1e-6;
+/// Two bodies whose distance, found by conservative advancement, falls to this (m) are in
+/// contact. Conservative advancement never steps over a contact, but a pass that grazes
+/// at a distance `d` for a while costs it about `rate / d` distance queries per second of
+/// grazing, and the optimizer is drawn to such passes (neighbouring pieces' shadows want
+/// to overlap). A near miss within 0.1 mm is a contact for any real launch, and counting
+/// it as one bounds the work per pass.
+pub const PAIR_CONTACT_DISTANCE: f64 = 1e-4;
 /// A body resting on the table at launch may sink this far (m) into it before that
 /// counts as a contact (it is launched from touching contact, distance 0).
 pub const TABLE_PENETRATION: f64 = 1e-4;
@@ -43,20 +51,115 @@ pub const TABLE_LEAVE: f64 = 1e-4;
 /// within micrometres for a long time) is reported as a contact, which is the safe side.
 const MAX_STEPS: usize = 100_000;
 
+/// Below this lower bound of the distance (m) between two sphere covers, conservative
+/// advancement asks parry for the exact distance; above it, the cheap bound drives it.
+const COVER_SWITCH: f64 = 1e-3;
+
 /// The geometry used by the distance queries.
 #[derive(Clone)]
 pub enum ContactShape {
     /// A sphere of this radius centred on the body origin (closed-form queries).
     Ball(f64),
-    /// Any other shape, as parry sees it in the body frame.
-    Parry(Arc<dyn ParryShape>),
+    /// Any other shape: as parry sees it in the body frame (used for penetration depths
+    /// only), its convex hull's vertices in f64 (body frame; distances come from
+    /// [`crate::gjk`]), and a cover of spheres (body frame) whose union contains it.
+    Parry(Arc<dyn ParryShape>, SphereCover, Option<Arc<Polytope>>),
+}
+
+/// Spheres (centre in the body frame, radius) whose union contains a convex shape. The
+/// distance between two covers is a lower bound of the distance between the shapes, and
+/// costs a few dozen flops instead of a GJK query: conservative advancement steps on it
+/// while the shapes are more than [`COVER_SWITCH`] apart.
+pub type SphereCover = Arc<[(DVec3, f64)]>;
+
+/// Number of slabs (spheres) of a cover.
+const COVER_SLABS: usize = 6;
+
+/// A sphere cover of the convex polytope with these vertices and edges: the polytope is
+/// cut into [`COVER_SLABS`] slabs across its longest axis-aligned extent, and each slab
+/// (whose vertices are the polytope's vertices inside it and its edges' crossings of the
+/// two planes) gets a bounding sphere. Every point of the polytope lies in some slab, so
+/// the union covers it.
+fn sphere_cover(points: &[DVec3], edges: &[[usize; 2]]) -> SphereCover {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for p in points {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let ext = hi - lo;
+    let k = if ext.x >= ext.y && ext.x >= ext.z {
+        0
+    } else if ext.y >= ext.z {
+        1
+    } else {
+        2
+    };
+    let mut cover = Vec::with_capacity(COVER_SLABS);
+    let mut pts: Vec<DVec3> = Vec::new();
+    for i in 0..COVER_SLABS {
+        let a = lo[k] + ext[k] * i as f64 / COVER_SLABS as f64;
+        let b = if i + 1 == COVER_SLABS {
+            hi[k]
+        } else {
+            lo[k] + ext[k] * (i + 1) as f64 / COVER_SLABS as f64
+        };
+        pts.clear();
+        pts.extend(points.iter().filter(|p| p[k] >= a && p[k] <= b));
+        for &[u, v] in edges {
+            let (p, q) = (points[u], points[v]);
+            for plane in [a, b] {
+                if (p[k] - plane) * (q[k] - plane) < 0.0 {
+                    let s = (plane - p[k]) / (q[k] - p[k]);
+                    pts.push(p + (q - p) * s);
+                }
+            }
+        }
+        if pts.is_empty() {
+            continue;
+        }
+        let (mut l, mut h) = (pts[0], pts[0]);
+        for p in &pts {
+            l = l.min(*p);
+            h = h.max(*p);
+        }
+        let c = 0.5 * (l + h);
+        let r = pts.iter().map(|p| p.distance(c)).fold(0.0, f64::max);
+        // Margin for rounding in the crossings and in parry's f32 geometry.
+        cover.push((c, r * (1.0 + 1e-6) + 1e-7));
+    }
+    cover.into()
+}
+
+/// Lower bound of the distance between two posed shapes from their sphere covers
+/// (negative when two cover spheres overlap), or `None` if one has no cover.
+fn cover_gap(
+    sa: &ContactShape,
+    pa: DVec3,
+    qa: DQuat,
+    sb: &ContactShape,
+    pb: DVec3,
+    qb: DQuat,
+) -> Option<f64> {
+    let (ca, cb) = match (sa, sb) {
+        (ContactShape::Parry(_, ca, _), ContactShape::Parry(_, cb, _)) => (ca, cb),
+        _ => return None,
+    };
+    let mut best = f64::INFINITY;
+    for &(c1, r1) in cb.iter() {
+        let w1 = pb + qb * c1;
+        for &(c0, r0) in ca.iter() {
+            let w0 = pa + qa * c0;
+            best = best.min(w0.distance(w1) - r0 - r1);
+        }
+    }
+    Some(best)
 }
 
 impl std::fmt::Debug for ContactShape {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             ContactShape::Ball(r) => write!(f, "Ball({r})"),
-            ContactShape::Parry(_) => write!(f, "Parry(..)"),
+            ContactShape::Parry(..) => write!(f, "Parry(..)"),
         }
     }
 }
@@ -67,12 +170,42 @@ impl ContactShape {
         match shape {
             Shape::Sphere { radius } => ContactShape::Ball(*radius),
             Shape::Cuboid { half_extents } => {
-                ContactShape::Parry(Arc::new(Cuboid::new(half_extents.as_vec3())))
+                let he = *half_extents;
+                let corners: Vec<DVec3> = (0..8)
+                    .map(|i| {
+                        DVec3::new(
+                            if i & 1 != 0 { he.x } else { -he.x },
+                            if i & 2 != 0 { he.y } else { -he.y },
+                            if i & 4 != 0 { he.z } else { -he.z },
+                        )
+                    })
+                    .collect();
+                let edges: Vec<[usize; 2]> = (0..8usize)
+                    .flat_map(|i| [1usize, 2, 4].map(move |b| [i, i | b]))
+                    .filter(|[i, j]| i != j)
+                    .collect();
+                let cover = sphere_cover(&corners, &edges);
+                ContactShape::Parry(
+                    Arc::new(Cuboid::new(he.as_vec3())),
+                    cover,
+                    Some(Arc::new(Polytope::new(corners, &edges))),
+                )
             }
             Shape::Mesh(mesh) => {
                 let pts: Vec<_> = mesh.vertices.iter().map(|v| v.as_vec3()).collect();
                 match ConvexPolyhedron::from_convex_hull(&pts) {
-                    Some(hull) => ContactShape::Parry(Arc::new(hull)),
+                    Some(hull) => {
+                        let points: Vec<DVec3> =
+                            hull.points().iter().map(|p| p.as_dvec3()).collect();
+                        let edges: Vec<[usize; 2]> = hull
+                            .edges()
+                            .iter()
+                            .map(|e| [e.vertices[0] as usize, e.vertices[1] as usize])
+                            .collect();
+                        let cover = sphere_cover(&points, &edges);
+                        let poly = Polytope::new(points, &edges);
+                        ContactShape::Parry(Arc::new(hull), cover, Some(Arc::new(poly)))
+                    }
                     // A degenerate hull cannot happen for a validated closed mesh with
                     // volume; fall back to the bounding ball about the origin to stay safe.
                     None => ContactShape::Ball(
@@ -86,7 +219,7 @@ impl ContactShape {
     fn parry(&self) -> Option<&dyn ParryShape> {
         match self {
             ContactShape::Ball(_) => None,
-            ContactShape::Parry(s) => Some(s.as_ref()),
+            ContactShape::Parry(s, ..) => Some(s.as_ref()),
         }
     }
 }
@@ -121,7 +254,7 @@ impl Motion<'_> {
 
     fn pose(&self, t: f64) -> (DVec3, DQuat) {
         match self {
-            Motion::Flying(f) => (f.origin(t), f.orientation(t)),
+            Motion::Flying(f) => f.pose(t),
             Motion::Fixed {
                 origin,
                 orientation,
@@ -164,13 +297,6 @@ fn safe_step(d: f64, a: f64, b: f64) -> f64 {
     2.0 * d / (a + (a * a + 2.0 * b * d).sqrt())
 }
 
-/// Separation of two bodies at time `t` (0 when touching or overlapping).
-fn separation(a: &Body, b: &Body, t: f64) -> f64 {
-    let (pa, qa) = a.motion.pose(t);
-    let (pb, qb) = b.motion.pose(t);
-    signed_distance(a.shape, pa, qa, b.shape, pb, qb).max(0.0)
-}
-
 /// Signed distance between two posed shapes (negative: penetration depth).
 pub fn signed_distance(
     sa: &ContactShape,
@@ -179,6 +305,35 @@ pub fn signed_distance(
     sb: &ContactShape,
     pb: DVec3,
     qb: DQuat,
+) -> f64 {
+    signed_distance_warm(
+        sa,
+        pa,
+        qa,
+        sb,
+        pb,
+        qb,
+        crate::gjk::REL_TOL,
+        &mut Warm::default(),
+    )
+}
+
+/// Relative accuracy of the distances conservative advancement asks for (they are lower
+/// bounds: 5 % low only shortens its steps by 5 %).
+const CA_REL_TOL: f64 = 0.05;
+
+/// [`signed_distance`] for a sequence of nearby poses of one pair: `warm` carries GJK's
+/// state from one query to the next (see [`crate::gjk::Warm`]).
+#[allow(clippy::too_many_arguments)]
+fn signed_distance_warm(
+    sa: &ContactShape,
+    pa: DVec3,
+    qa: DQuat,
+    sb: &ContactShape,
+    pb: DVec3,
+    qb: DQuat,
+    rel_tol: f64,
+    warm: &mut Warm,
 ) -> f64 {
     match (sa, sb) {
         (ContactShape::Ball(ra), ContactShape::Ball(rb)) => pa.distance(pb) - ra - rb,
@@ -205,6 +360,18 @@ pub fn signed_distance(
                     &ball_b
                 }
             };
+            // Separated shapes: the f64 GJK of `crate::gjk` on the hull vertices (a
+            // ball is its centre, its radius subtracted). Only a penetration depth,
+            // needed for bodies that touch at launch, comes from parry.
+            let (va, vb) = (hull_points(sa), hull_points(sb));
+            if let (Some(va), Some(vb)) = (va, vb) {
+                let d = crate::gjk::distance_lower_bound_warm(va, vb, rel_q, rel_p, rel_tol, warm)
+                    - ball_radius(sa)
+                    - ball_radius(sb);
+                if d > CONTACT_DISTANCE {
+                    return d;
+                }
+            }
             match query::contact(&pose_a, ga, &pose_b, gb, f32::MAX) {
                 Ok(Some(c)) => c.dist as f64,
                 // Not reachable for the supported shape pairs; treat as far apart.
@@ -214,10 +381,23 @@ pub fn signed_distance(
     }
 }
 
+/// The points whose convex hull is the shape, for [`crate::gjk`]: the hull's vertices,
+/// or a ball's centre (its radius is subtracted from the distance).
+fn hull_points(s: &ContactShape) -> Option<&Polytope> {
+    // Built once: a ball's centre in its own frame.
+    static CENTRE: std::sync::LazyLock<Polytope> =
+        std::sync::LazyLock::new(|| Polytope::point(DVec3::ZERO));
+    match s {
+        ContactShape::Parry(_, _, Some(p)) => Some(p),
+        ContactShape::Ball(_) => Some(&CENTRE),
+        _ => None,
+    }
+}
+
 fn ball_radius(s: &ContactShape) -> f64 {
     match s {
         ContactShape::Ball(r) => *r,
-        ContactShape::Parry(_) => 0.0,
+        ContactShape::Parry(..) => 0.0,
     }
 }
 
@@ -235,12 +415,17 @@ pub fn pair_contact_time(a: &Body, b: &Body, horizon: f64) -> Option<f64> {
     }
     let both_fly = a.motion.is_flying() && b.motion.is_flying();
     let reach = a.radius + b.radius;
+    // The end of the search: the horizon, or the moment the bounding spheres part for
+    // good (two flying bodies only; then no contact is possible afterwards).
+    let mut end = horizon;
     // 1. Bounding spheres about the centres of mass.
     let s0 = if both_fly {
         // Gravity cancels: d(s) = d0 + dv s exactly.
         let d0 = b.motion.com(0.0) - a.motion.com(0.0);
         let dv = b.motion.com_velocity(0.0) - a.motion.com_velocity(0.0);
-        first_linear_approach(d0, dv, reach, horizon)?
+        let (s_in, s_out) = linear_overlap_interval(d0, dv, reach, horizon)?;
+        end = s_out;
+        s_in
     } else {
         let g = if a.motion.is_flying() {
             a.motion.com_velocity(1.0) - a.motion.com_velocity(0.0)
@@ -280,18 +465,57 @@ pub fn pair_contact_time(a: &Body, b: &Body, horizon: f64) -> Option<f64> {
     let gn = g_rel.length();
     let spin = a.motion.max_angular_speed() * a.radius + b.motion.max_angular_speed() * b.radius;
     let mut s = s0;
+    let mut warm = Warm::default();
     for _ in 0..MAX_STEPS {
-        let d = separation(a, b, s);
-        if d <= CONTACT_DISTANCE {
+        let (pa, qa) = a.motion.pose(s);
+        let (pb, qb) = b.motion.pose(s);
+        // The covers' gap bounds the distance from below, which is all that
+        // conservative advancement needs; the exact query is only needed up close.
+        let d = match cover_gap(a.shape, pa, qa, b.shape, pb, qb) {
+            Some(lb) if lb > COVER_SWITCH => lb,
+            _ => signed_distance_warm(a.shape, pa, qa, b.shape, pb, qb, CA_REL_TOL, &mut warm)
+                .max(0.0),
+        };
+        if d <= PAIR_CONTACT_DISTANCE {
             return Some(s);
         }
         let rel_v = (b.motion.com_velocity(s) - a.motion.com_velocity(s)).length();
         s += safe_step(d, rel_v + spin, gn);
-        if s > horizon {
+        if s > end {
             return None;
         }
     }
     Some(s)
+}
+
+/// The times in `[0, horizon]` at which `|d0 + dv s| <= reach`: an interval
+/// `(s_in, s_out)` (the set is convex, `|d0 + dv s|` being convex in `s`), or `None` if
+/// there are none. `s_out` is at most `horizon`.
+fn linear_overlap_interval(d0: DVec3, dv: DVec3, reach: f64, horizon: f64) -> Option<(f64, f64)> {
+    let c = d0.length_squared() - reach * reach;
+    let a = dv.length_squared();
+    let b = d0.dot(dv);
+    if a == 0.0 {
+        return (c <= 0.0).then_some((0.0, horizon));
+    }
+    // Roots of a s^2 + 2 b s + c = 0; the set is between them.
+    let disc = b * b - a * c;
+    if disc < 0.0 {
+        return None;
+    }
+    let sq = disc.sqrt();
+    // Cancellation-free pair of roots.
+    let qv = -(b + b.signum() * sq);
+    let (r1, r2) = if qv != 0.0 {
+        (qv / a, c / qv)
+    } else {
+        (0.0, 0.0)
+    };
+    let (lo, hi) = (r1.min(r2), r1.max(r2));
+    // A small relative margin keeps rounding in the roots on the safe side.
+    let margin = 1e-12 * (1.0 + hi.abs());
+    let (lo, hi) = (lo.max(0.0), (hi + margin).min(horizon));
+    (lo <= hi).then_some((lo, hi))
 }
 
 /// Contact time of two bodies that touch at launch (signed distance `d0` <= 1 um).
@@ -303,10 +527,11 @@ fn touching_pair_contact_time(a: &Body, b: &Body, d0: f64, horizon: f64) -> Opti
     let sink_floor = d0.min(0.0) - TABLE_PENETRATION;
     let mut left = false;
     let mut s = 0.0;
+    let mut warm = Warm::default();
     for _ in 0..MAX_STEPS {
         let (pa, qa) = a.motion.pose(s);
         let (pb, qb) = b.motion.pose(s);
-        let d = signed_distance(a.shape, pa, qa, b.shape, pb, qb);
+        let d = signed_distance_warm(a.shape, pa, qa, b.shape, pb, qb, CA_REL_TOL, &mut warm);
         if !left && d > TABLE_LEAVE {
             left = true;
         }
@@ -321,26 +546,6 @@ fn touching_pair_contact_time(a: &Body, b: &Body, d0: f64, horizon: f64) -> Opti
         }
     }
     Some(s)
-}
-
-/// First `s` in `[0, horizon]` with `|d0 + dv s| <= reach`.
-fn first_linear_approach(d0: DVec3, dv: DVec3, reach: f64, horizon: f64) -> Option<f64> {
-    let c = d0.length_squared() - reach * reach;
-    if c <= 0.0 {
-        return Some(0.0);
-    }
-    let a = dv.length_squared();
-    let b = d0.dot(dv);
-    if a == 0.0 || b >= 0.0 {
-        return None; // not approaching
-    }
-    let disc = b * b - a * c;
-    if disc < 0.0 {
-        return None;
-    }
-    // Smaller root of a s^2 + 2 b s + c = 0, cancellation-free (b < 0).
-    let s = c / (-b + disc.sqrt());
-    (s <= horizon).then_some(s)
 }
 
 /// Signed distance from a posed shape to the table box (negative: penetration).
@@ -360,13 +565,41 @@ fn table_signed_distance(
             let inside = (local.abs() - h).max_element().min(0.0);
             outside.length() + inside - r
         }
+        ContactShape::Parry(_, _, Some(poly)) => {
+            // Over the top face, away from its edges, the closest part of the table is
+            // the top plane: the distance is the height of the lowest vertex, exactly.
+            let r = poly.radius();
+            let local = p - table.center;
+            let h = table.half_extents;
+            if local.x.abs() + r <= h.x && local.y.abs() + r <= h.y {
+                let low = p + q * poly.support_point(q.inverse() * DVec3::NEG_Z);
+                low.z - table.top()
+            } else {
+                signed_distance(shape, p, q, table_shape, table.center, DQuat::IDENTITY)
+            }
+        }
         _ => signed_distance(shape, p, q, table_shape, table.center, DQuat::IDENTITY),
     }
 }
 
 /// The table as a query shape.
 pub fn table_shape(table: &Table) -> ContactShape {
-    ContactShape::Parry(Arc::new(Cuboid::new(table.half_extents.as_vec3())))
+    // The table's queries never use a cover (see `sphere_clear_of_top`).
+    let he = table.half_extents;
+    let corners: Vec<DVec3> = (0..8)
+        .map(|i| {
+            DVec3::new(
+                if i & 1 != 0 { he.x } else { -he.x },
+                if i & 2 != 0 { he.y } else { -he.y },
+                if i & 4 != 0 { he.z } else { -he.z },
+            )
+        })
+        .collect();
+    ContactShape::Parry(
+        Arc::new(Cuboid::new(he.as_vec3())),
+        Arc::new([]),
+        Some(Arc::new(Polytope::new(corners, &[]))),
+    )
 }
 
 /// First time in `(0, horizon]` at which a flying body, launched from rest on (or above)
@@ -428,6 +661,20 @@ pub fn table_contact(
             let landed = left && flight.com_velocity(s).z < 0.0;
             return Some(TableContact { time: s, landed });
         }
+        if left {
+            // While the bounding sphere is above the top face, nothing can touch the
+            // table: jump to when its lowest point could come back down to the top.
+            if let Some(next) = sphere_clear_of_top(flight, body.radius, table, s, horizon) {
+                match next {
+                    Some(s_next) if s_next > s => {
+                        s = s_next;
+                        continue;
+                    }
+                    Some(_) => {}
+                    None => return None,
+                }
+            }
+        }
         let v = flight.com_velocity(s).length();
         let step = safe_step(d - floor, v + spin, g).max(1e-9);
         s += step;
@@ -439,6 +686,62 @@ pub fn table_contact(
         time: s,
         landed: left && flight.com_velocity(s).z < 0.0,
     })
+}
+
+/// If the bounding sphere (about the centre of mass, radius `r`) is entirely above the
+/// table's top face at time `s`, the first later time at which it could touch the top
+/// again: `Some(Some(time))`, or `Some(None)` if not before `horizon`. `None` when the
+/// sphere is not clear of the top at `s` (use conservative advancement).
+///
+/// While the sphere's lowest point is above the top plane and its centre stays over the
+/// top face shrunk by `r`, the body cannot touch the table: the centre moves on a line
+/// horizontally (a convex region contains the whole segment if it contains both ends),
+/// and the lowest point's height is a quadratic in time.
+fn sphere_clear_of_top(
+    f: &FreeFlight,
+    r: f64,
+    table: &Table,
+    s: f64,
+    horizon: f64,
+) -> Option<Option<f64>> {
+    let top = table.top();
+    let inside = |c: DVec3| {
+        let d = (c - table.center).abs();
+        d.x + r <= table.half_extents.x && d.y + r <= table.half_extents.y
+    };
+    let c = f.com(s);
+    let h0 = c.z - r - top;
+    // Written so that a NaN height also declines.
+    if h0.partial_cmp(&CONTACT_DISTANCE) != Some(std::cmp::Ordering::Greater) || !inside(c) {
+        return None;
+    }
+    // h(s + u) = h0 + b u + a u^2 / 2; first u > 0 with h = 0 (a < 0 under gravity).
+    let b = f.com_velocity(s).z;
+    let a = f.com_velocity(s + 1.0).z - b;
+    let u = if a < 0.0 {
+        // Positive root of a/2 u^2 + b u + h0 = 0, cancellation-free.
+        let disc = b * b - 2.0 * a * h0;
+        let sq = disc.max(0.0).sqrt();
+        if b >= 0.0 {
+            (b + sq) / (-a)
+        } else {
+            2.0 * h0 / (sq - b)
+        }
+    } else if b < 0.0 {
+        // No downward gravity: a linear (or slower) descent.
+        h0 / (-b)
+    } else {
+        f64::INFINITY
+    };
+    // A hair early, so that rounding can never skip past a contact.
+    let next = s + u * (1.0 - 1e-9);
+    if next > horizon {
+        return Some(None);
+    }
+    if !inside(f.com(next)) {
+        return None;
+    }
+    Some(Some(next))
 }
 
 /// Closed-form table contact of a ball that starts over the table's top face: its lowest
@@ -722,8 +1025,10 @@ mod tests {
         let t = pair_contact_time(&ba, &bb, 1.0).expect("grazing contact found");
         // They can only touch around the crossing at t = 1/80 s.
         assert!((t - 0.0125).abs() < 1e-3, "{t}");
-        // Verify it is a real touch, not an early stop.
-        assert!(separation(&ba, &bb, t) <= CONTACT_DISTANCE);
+        // Verify it is a real touch (within the pair contact distance), not an early stop.
+        let ((pa, qa), (pb, qb)) = (ba.motion.pose(t), bb.motion.pose(t));
+        let d = signed_distance(ba.shape, pa, qa, bb.shape, pb, qb);
+        assert!(d <= PAIR_CONTACT_DISTANCE, "{d}");
     }
 
     #[test]
@@ -856,7 +1161,7 @@ mod tests {
             let v = DVec3::new(4.0 * rnd() - 2.0, 4.0 * rnd() - 2.0, 8.0 * rnd() - 1.0);
             let f = flight(&s, p, v, DVec3::ZERO, g, 2.0);
             let exact = ContactShape::new(&s);
-            let parry = ContactShape::Parry(Arc::new(Ball::new(r as f32)));
+            let parry = ContactShape::Parry(Arc::new(Ball::new(r as f32)), Arc::new([]), None);
             let a = Body {
                 motion: Motion::Flying(&f),
                 shape: &exact,

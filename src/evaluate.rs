@@ -27,7 +27,7 @@ use crate::body::{FlightConfig, FreeFlight, Shape};
 use crate::contact::{self, Body, ContactShape, Motion};
 use crate::energy::{self, TargetData, Term, Weights, DIVERGED_ENERGY, REG_ALPHA, TERM_COUNT};
 use crate::mask::Mask;
-use crate::raster::RasterScratch;
+use crate::raster::{MeshSilhouette, RasterScratch};
 use crate::scene::Scene;
 
 /// Largest total rotation (rad) of a launched body by `t` that a sample may ask for; more
@@ -45,6 +45,8 @@ pub struct Problem {
     table_shape: Option<ContactShape>,
     /// Whether each mesh is closed and outward-oriented (enables back-face culling).
     closed: Vec<bool>,
+    /// Silhouette data of each closed, outward-oriented mesh (the fast shadow path).
+    silhouettes: Vec<Option<MeshSilhouette>>,
     pub flight: FlightConfig,
 }
 
@@ -133,12 +135,22 @@ impl Problem {
             })
             .collect();
         let table_shape = scene.table.as_ref().map(contact::table_shape);
+        let silhouettes = scene
+            .occluders
+            .iter()
+            .zip(&closed)
+            .map(|(o, &closed)| match &o.shape {
+                Shape::Mesh(m) if closed => MeshSilhouette::new(&m.vertices, &m.triangles),
+                _ => None,
+            })
+            .collect();
         Problem {
             scene,
             target,
             shapes,
             table_shape,
             closed,
+            silhouettes,
             flight: FlightConfig::default(),
         }
     }
@@ -372,6 +384,16 @@ impl Problem {
                 Shape::Cuboid { half_extents } => {
                     cam.rasterize_box(p, q, *half_extents, &mut ws.mask, &mut ws.raster)
                 }
+                Shape::Mesh(mesh) if self.silhouettes[i].is_some() => cam.rasterize_mesh(
+                    p,
+                    q,
+                    &mesh.vertices,
+                    &mesh.triangles,
+                    self.silhouettes[i].as_ref().expect("checked"),
+                    &mut ws.world_vertices,
+                    &mut ws.mask,
+                    &mut ws.raster,
+                ),
                 Shape::Mesh(mesh) => {
                     ws.world_vertices.clear();
                     ws.world_vertices

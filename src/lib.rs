@@ -15,6 +15,7 @@ pub mod continuation;
 pub mod energy;
 pub mod evaluate;
 pub mod export;
+pub mod gjk;
 pub mod gltf_export;
 pub mod linalg;
 pub mod mask;
