@@ -9,9 +9,11 @@
 
 pub mod body;
 pub mod cli;
+pub mod budget;
 pub mod cmaes;
 pub mod contact;
 pub mod continuation;
+pub mod drag;
 pub mod energy;
 pub mod evaluate;
 pub mod export;
