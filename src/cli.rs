@@ -1004,9 +1004,10 @@ fn budget(
     let mut md = r.markdown();
     md.push_str(&format!(
         "\nMade by `bsa budget` in {elapsed:.2} s on {} threads.\n",
-        opts.threads.unwrap_or_else(|| std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1))
+        opts.threads
+            .unwrap_or_else(|| std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1))
     ));
     export::write_atomic(&dir.join("budget.md"), md.as_bytes())?;
     let h = &r.histogram;
@@ -1063,7 +1064,10 @@ fn budget(
             })
             .collect();
         let refs: Vec<&image::RgbImage> = panels.iter().collect();
-        export::save_png(&picture::side_by_side(&refs, 0), &dir.join("budget_tolerances.png"))?;
+        export::save_png(
+            &picture::side_by_side(&refs, 0),
+            &dir.join("budget_tolerances.png"),
+        )?;
     }
 
     println!(
@@ -1109,7 +1113,11 @@ fn budget(
     println!(
         "wrote {}/{{budget.md, budget.json, launch_drag.csv, budget_hist.png{}}} in {elapsed:.2} s",
         dir.display(),
-        if r.search.is_some() { ", budget_tolerances.png" } else { "" }
+        if r.search.is_some() {
+            ", budget_tolerances.png"
+        } else {
+            ""
+        }
     );
     Ok(())
 }

@@ -87,7 +87,9 @@ impl Default for DragConfig {
 pub enum DragError {
     #[error("air density must be between 0 and {MAX_DENSITY} kg/m^3, got {0}")]
     Density(f64),
-    #[error("the drag coefficient of {shape} must be between 0 and {MAX_COEFFICIENT}, got {value}")]
+    #[error(
+        "the drag coefficient of {shape} must be between 0 and {MAX_COEFFICIENT}, got {value}"
+    )]
     Coefficient { shape: &'static str, value: f64 },
     #[error("the integrator step must be positive and at most 0.1 s, got {0}")]
     Step(f64),
@@ -313,7 +315,11 @@ mod tests {
                 let v_ref = -vt * (g * t / vt).tanh();
                 let x_ref = -vt * vt / g * (g * t / vt).cosh().ln();
                 worst = worst.max((x.z - x_ref).abs());
-                assert!((v.z - v_ref).abs() < 1e-7, "k {k} t {t}: v {} vs {v_ref}", v.z);
+                assert!(
+                    (v.z - v_ref).abs() < 1e-7,
+                    "k {k} t {t}: v {} vs {v_ref}",
+                    v.z
+                );
                 assert!(x.x == 0.0 && x.y == 0.0);
             }
             eprintln!("tanh fall, k = {k} 1/m, v_T = {vt:.3} m/s: max position error {worst:.3e} m over 1.5 s");
@@ -355,14 +361,7 @@ mod tests {
 
     /// An independent tiny-step reference for a 3-D throw with drag and Magnus lift:
     /// explicit midpoint (second order, a different method) with 1e-5 s steps.
-    fn midpoint_reference(
-        b: &BodyDrag,
-        v0: DVec3,
-        w: DVec3,
-        g: DVec3,
-        t: f64,
-        n: usize,
-    ) -> DVec3 {
+    fn midpoint_reference(b: &BodyDrag, v0: DVec3, w: DVec3, g: DVec3, t: f64, n: usize) -> DVec3 {
         let h = t / n as f64;
         let acc = |v: DVec3| -> DVec3 {
             let s = v.length();
@@ -403,7 +402,10 @@ mod tests {
             let x_ref = midpoint_reference(&b, v0, w, g, t, 300_000);
             for step in [0.001, 0.002, 0.005, 0.01, 0.02] {
                 let (x, _) = fly(&b, DVec3::ZERO, v0, w, g, t, step);
-                eprintln!("  RK4 step {step} s: {:.3e} m from the reference", x.distance(x_ref));
+                eprintln!(
+                    "  RK4 step {step} s: {:.3e} m from the reference",
+                    x.distance(x_ref)
+                );
             }
             let (x, _) = fly(&b, DVec3::ZERO, v0, w, g, t, DEFAULT_MAX_STEP);
             let vacuum = v0 * t + 0.5 * g * t * t;
@@ -466,8 +468,18 @@ mod tests {
         assert!(e.to_string().contains("air density"));
         let e = ok.with_cd(-0.5).validate().unwrap_err();
         assert!(matches!(e, DragError::Coefficient { value, .. } if value == -0.5));
-        let e = DragConfig { cd_box: f64::NAN, ..ok }.validate().unwrap_err();
+        let e = DragConfig {
+            cd_box: f64::NAN,
+            ..ok
+        }
+        .validate()
+        .unwrap_err();
         assert!(matches!(e, DragError::Coefficient { shape: "boxes", .. }));
-        assert!(DragConfig { max_step: 0.0, ..ok }.validate().is_err());
+        assert!(DragConfig {
+            max_step: 0.0,
+            ..ok
+        }
+        .validate()
+        .is_err());
     }
 }

@@ -8,8 +8,8 @@
 //! -> [`solver`] with [`cmaes`] (stages of CMA-ES) -> [`export`] (files).
 
 pub mod body;
-pub mod cli;
 pub mod budget;
+pub mod cli;
 pub mod cmaes;
 pub mod contact;
 pub mod continuation;

@@ -814,7 +814,6 @@ fn draw_panel(
     img
 }
 
-
 // ---------------------------------------------------------------------------
 // Linear-axis plots: histogram and line plot (error budget)
 // ---------------------------------------------------------------------------
@@ -929,7 +928,14 @@ fn linear_frame(
         fill_rect(&mut img, ax.left - 3 * si, py, 3 * si, 1, FRAME);
         let label = tick_label(*v, ystep);
         let w = text_width(&label, s) as i32;
-        draw_text(&mut img, ax.left - 5 * si - w, py - cap / 2, &label, TEXT, s);
+        draw_text(
+            &mut img,
+            ax.left - 5 * si - w,
+            py - cap / 2,
+            &label,
+            TEXT,
+            s,
+        );
     }
     let xt = linear_ticks(x.0, x.1, 5);
     let xstep = if xt.len() > 1 { xt[1] - xt[0] } else { 1.0 };
@@ -999,7 +1005,14 @@ pub fn histogram_plot(
                 ax.bottom - y + 1,
                 TERM_COLORS[0],
             );
-            rect_outline(&mut img, x0, y, (x1 - x0).max(1) + 1, ax.bottom - y + 1, WHITE);
+            rect_outline(
+                &mut img,
+                x0,
+                y,
+                (x1 - x0).max(1) + 1,
+                ax.bottom - y + 1,
+                WHITE,
+            );
         }
     }
     if let Some(m) = marker.filter(|m| (lo..=hi).contains(m)) {
@@ -1091,7 +1104,14 @@ pub fn line_plot(
         rect_outline(&mut img, lx, ly, lw, lh, FRAME);
         for (k, s) in series.iter().enumerate() {
             let y0 = ly + 4 * si + k as i32 * line_h;
-            fill_rect(&mut img, lx + 4 * si, y0 + th / 2 - si, 12 * si, 2 * si, s.color);
+            fill_rect(
+                &mut img,
+                lx + 4 * si,
+                y0 + th / 2 - si,
+                12 * si,
+                2 * si,
+                s.color,
+            );
             draw_text(&mut img, lx + 18 * si, y0, &s.name, TEXT, sc);
         }
     }
