@@ -64,12 +64,8 @@ fn benches(c: &mut Criterion) {
         })
     });
     group.bench_function("budget_mickey_10k_2_threads", |b| {
-        let budget = bsa::budget::Budget::new(
-            &p,
-            &NEAR_SOLUTION,
-            bsa::drag::DragConfig::default(),
-        )
-        .expect("valid drag config");
+        let budget = bsa::budget::Budget::new(&p, &NEAR_SOLUTION, bsa::drag::DragConfig::default())
+            .expect("valid drag config");
         let (comp, _) = budget.compensate();
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(2)

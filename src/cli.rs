@@ -1012,13 +1012,11 @@ fn budget(
     export::write_atomic(&dir.join("budget.md"), md.as_bytes())?;
     let h = &r.histogram;
     let hist = picture::histogram_plot(
+        &format!("{}: IoU at t, {} samples", r.scene, r.monte_carlo.samples),
         &format!(
-            "{}: IoU at t, {} samples (P(IoU>=0.9) = {:.1}%)",
-            r.scene,
-            r.monte_carlo.samples,
+            "IoU (red: 0.9; P(IoU >= 0.9) = {:.1} %)",
             100.0 * r.monte_carlo.p_iou_at_least_0_9
         ),
-        "IoU",
         h.lo,
         h.hi,
         &h.counts,

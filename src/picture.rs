@@ -905,7 +905,7 @@ fn linear_frame(
     let ax = LinearAxes {
         left: 4 * si + th + 6 * si + tick_w + 5 * si,
         top: 6 * si + text_height(s + 1) as i32 + 6 * si,
-        right: width as i32 - 10 * si,
+        right: width as i32 - 16 * si,
         bottom: height as i32 - (4 * si + th + 5 * si + th + 6 * si),
         x,
         y,
