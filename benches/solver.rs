@@ -6,6 +6,9 @@
 //!   every term of stage 2; target <= 50 us).
 //! - `sample_mickey_all_terms`: the same with all ten terms on.
 //! - `solve_mickey_2_threads`: the whole two-stage Mickey solve on 2 threads (target <= 5 s).
+//! - `budget_mickey_10k_2_threads`: the error budget's Monte Carlo, 10,000 samples of the
+//!   drag-compensated Mickey launch in air at the default tolerances, on 2 threads
+//!   (target <= 10 s).
 
 use std::hint::black_box;
 use std::path::Path;
@@ -59,6 +62,17 @@ fn benches(c: &mut Criterion) {
             };
             black_box(solver::solve(&p, &opts, &mut solver::Silent, &none))
         })
+    });
+    group.bench_function("budget_mickey_10k_2_threads", |b| {
+        let budget = bsa::budget::Budget::new(&p, &NEAR_SOLUTION, bsa::drag::DragConfig::default())
+            .expect("valid drag config");
+        let (comp, _) = budget.compensate();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("thread pool");
+        let tol = bsa::budget::Tolerances::default();
+        b.iter(|| black_box(budget.monte_carlo(&comp, &tol, 10_000, 1, &pool, &())))
     });
     group.finish();
 }

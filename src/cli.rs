@@ -3,7 +3,8 @@
 //! Subcommands: `check` (validate a scene and print a summary), `solve` (optimise and
 //! write `export/<scene>/`), `eval` (print every energy term of a saved solution),
 //! `export` (animated glTF and launch tables of a saved solution), `validate` (Blender
-//! Cycles shadow against the rasterizer) and `video` (an MP4 of the flight). `validate`
+//! Cycles shadow against the rasterizer), `video` (an MP4 of the flight) and `budget`
+//! (air drag, the drag-compensated launch table and launch tolerances). `validate`
 //! and `video` run the scripts of `blender/` with a Python that has `bpy`.
 //! This is the only module that uses `anyhow`, prints, draws progress bars or installs
 //! the Ctrl-C handler; library modules return typed errors.
@@ -109,6 +110,55 @@ enum Command {
         #[arg(long)]
         python: Option<PathBuf>,
     },
+    /// Error budget of a saved solution: re-simulation with air drag, drag-compensated
+    /// launch table (launch_drag.csv), Monte Carlo of launch errors, sensitivities and
+    /// the largest tolerances; writes budget.md, budget.json and two PNG plots.
+    Budget {
+        /// Output folder of a solve (holding solution.json), or the solution.json itself.
+        path: PathBuf,
+        /// Scene folder or file [default: the one recorded in solution.json, else scenes/<name>].
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Monte Carlo samples at the requested tolerances.
+        #[arg(long, default_value_t = 10_000)]
+        samples: usize,
+        /// Samples per evaluation of the tolerance search (0: skip the search).
+        #[arg(long, default_value_t = 2_000)]
+        search_samples: usize,
+        /// Random seed of the Monte Carlo (the report is identical for a seed whatever the threads).
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Worker threads [default: one per core].
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Air density (kg/m^3).
+        #[arg(long, default_value_t = crate::drag::AIR_DENSITY, allow_negative_numbers = true)]
+        rho: f64,
+        /// Drag coefficient for every body [default: sphere 0.47, box 1.05, mesh 1.0].
+        #[arg(long, allow_negative_numbers = true)]
+        cd: Option<f64>,
+        /// Magnus lift on spinning spheres.
+        #[arg(long)]
+        magnus: bool,
+        /// Launch speed error, 1 sigma (% of the speed).
+        #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+        speed_tol: f64,
+        /// Launch direction error, 1 sigma per perpendicular component (deg).
+        #[arg(long, default_value_t = 0.25, allow_negative_numbers = true)]
+        direction_tol: f64,
+        /// Spin rate error, 1 sigma (% of the angular speed).
+        #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
+        spin_tol: f64,
+        /// Release timing error, 1 sigma (ms).
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+        timing_tol: f64,
+        /// Drag coefficient error, 1 sigma (% of Cd).
+        #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
+        cd_tol: f64,
+        /// No progress bars.
+        #[arg(long, short)]
+        quiet: bool,
+    },
     /// Print every energy term of a solution, raw and weighted.
     Eval {
         /// Scene folder (holding scene.json) or scene file.
@@ -157,6 +207,47 @@ pub fn run(cli: Cli) -> Result<()> {
             let msg = write_exports(&dir, &problem, &solution, after)?;
             println!("{msg}");
             Ok(())
+        }
+        Command::Budget {
+            path,
+            scene,
+            samples,
+            search_samples,
+            seed,
+            threads,
+            rho,
+            cd,
+            magnus,
+            speed_tol,
+            direction_tol,
+            spin_tol,
+            timing_tol,
+            cd_tol,
+            quiet,
+        } => {
+            let mut drag = crate::drag::DragConfig {
+                rho,
+                magnus,
+                ..Default::default()
+            };
+            if let Some(cd) = cd {
+                drag = drag.with_cd(cd);
+            }
+            let opts = crate::budget::BudgetOptions {
+                drag,
+                tolerances: crate::budget::Tolerances {
+                    speed_pct: speed_tol,
+                    direction_deg: direction_tol,
+                    spin_pct: spin_tol,
+                    timing_ms: timing_tol,
+                    cd_pct: cd_tol,
+                },
+                samples,
+                search_samples,
+                seed,
+                threads,
+            };
+            budget(&path, scene.as_deref(), &opts, quiet)
         }
         Command::Validate { dir, scene, python } => validate(&dir, scene.as_deref(), python),
         Command::Video {
@@ -857,5 +948,220 @@ fn eval(
             }
         }
     }
+    Ok(())
+}
+
+/// Progress bars of the budget's long phases.
+struct BudgetBars {
+    bar: std::sync::Mutex<Option<ProgressBar>>,
+    quiet: bool,
+}
+
+impl crate::budget::Progress for BudgetBars {
+    fn start(&self, phase: &str, total: u64) {
+        let bar = ProgressBar::new(total);
+        if self.quiet {
+            bar.set_draw_target(ProgressDrawTarget::hidden());
+        }
+        bar.set_style(
+            ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} {per_sec} eta {eta}")
+                .expect("static template")
+                .progress_chars("=> "),
+        );
+        bar.set_prefix(phase.to_string());
+        *self.bar.lock().unwrap_or_else(|e| e.into_inner()) = Some(bar);
+    }
+    fn advance(&self, n: u64) {
+        if let Some(b) = self.bar.lock().unwrap_or_else(|e| e.into_inner()).as_ref() {
+            b.inc(n);
+        }
+    }
+    fn finish(&self) {
+        if let Some(b) = self.bar.lock().unwrap_or_else(|e| e.into_inner()).take() {
+            b.finish_and_clear();
+        }
+    }
+}
+
+fn budget(
+    path: &Path,
+    scene: Option<&Path>,
+    opts: &crate::budget::BudgetOptions,
+    quiet: bool,
+) -> Result<()> {
+    use crate::budget;
+    use crate::picture::{self, Series};
+    let (dir, file) = if path.is_file() {
+        let dir = path
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        (dir.to_path_buf(), path.to_path_buf())
+    } else {
+        (path.to_path_buf(), path.join("solution.json"))
+    };
+    if !file.is_file() {
+        bail!(
+            "{} has no solution.json: run `bsa solve <scene> --out {}` first",
+            dir.display(),
+            dir.display()
+        );
+    }
+    let solution = export::read_solution(&file)?;
+    let scene_path = match scene {
+        Some(p) => p.to_path_buf(),
+        None => solution
+            .scene_file
+            .as_ref()
+            .map(PathBuf::from)
+            .filter(|p| p.exists())
+            .unwrap_or_else(|| PathBuf::from("scenes").join(&solution.scene)),
+    };
+    let problem = Problem::new(load_scene(&scene_path)?);
+    budget::check_solution_current(&problem, &solution).with_context(|| {
+        format!(
+            "{} does not belong to the scene {} (pass the right one with --scene)",
+            file.display(),
+            scene_path.display()
+        )
+    })?;
+    budget::validate_options(&problem, opts).context("invalid budget options")?;
+    let bars = BudgetBars {
+        bar: std::sync::Mutex::new(None),
+        quiet,
+    };
+    let start = Instant::now();
+    let run = budget::run(&problem, &solution.parameters(), opts, &bars)?;
+    let elapsed = start.elapsed().as_secs_f64();
+    let r = &run.report;
+
+    // launch_drag.csv: the launch table of the compensated launch, its pose at t with drag.
+    let mut rows = crate::trajectory::launch_rows(&problem, &run.compensated);
+    for (row, com) in rows.iter_mut().zip(&run.compensated_com) {
+        row.com_at_t_x_m = com.x;
+        row.com_at_t_y_m = com.y;
+        row.com_at_t_z_m = com.z;
+    }
+    export::write_csv(&dir.join("launch_drag.csv"), &rows)?;
+    export::write_atomic(
+        &dir.join("budget.json"),
+        serde_json::to_string_pretty(r)?.as_bytes(),
+    )?;
+    let mut md = r.markdown();
+    md.push_str(&format!(
+        "\nMade by `bsa budget` in {elapsed:.2} s on {} threads.\n",
+        opts.threads
+            .unwrap_or_else(|| std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1))
+    ));
+    export::write_atomic(&dir.join("budget.md"), md.as_bytes())?;
+    let h = &r.histogram;
+    let hist = picture::histogram_plot(
+        &format!("{}: IoU at t, {} samples", r.scene, r.monte_carlo.samples),
+        &format!(
+            "IoU (red: 0.9; P(IoU >= 0.9) = {:.1} %)",
+            100.0 * r.monte_carlo.p_iou_at_least_0_9
+        ),
+        h.lo,
+        h.hi,
+        &h.counts,
+        Some(budget::IOU_THRESHOLD),
+        640,
+        400,
+    );
+    export::save_png(&hist, &dir.join("budget_hist.png"))?;
+    if let Some(se) = &r.search {
+        let panels: Vec<image::RgbImage> = se
+            .single
+            .iter()
+            .map(|p| {
+                let pts = |f: &dyn Fn(&budget::CurvePoint) -> f64| {
+                    p.curve.iter().map(|c| (c.size, f(c))).collect()
+                };
+                picture::line_plot(
+                    &format!("{} error alone", p.parameter),
+                    &format!("1 sigma ({})", p.unit),
+                    "IoU / probability",
+                    &[
+                        Series {
+                            name: "mean IoU".into(),
+                            color: picture::BLUE,
+                            points: pts(&|c| c.mean),
+                        },
+                        Series {
+                            name: "5th pct IoU".into(),
+                            color: image::Rgb([44, 160, 44]),
+                            points: pts(&|c| c.p5),
+                        },
+                        Series {
+                            name: "P(IoU>=0.9)".into(),
+                            color: picture::RED,
+                            points: pts(&|c| c.p_iou_at_least_0_9),
+                        },
+                    ],
+                    (0.0, 1.0),
+                    Some(p.largest),
+                    380,
+                    300,
+                )
+            })
+            .collect();
+        let refs: Vec<&image::RgbImage> = panels.iter().collect();
+        export::save_png(
+            &picture::side_by_side(&refs, 0),
+            &dir.join("budget_tolerances.png"),
+        )?;
+    }
+
+    println!(
+        "{}: IoU at t {:.4} in vacuum, {:.4} with drag, {:.4} with the drag-compensated launch",
+        r.scene, r.iou_vacuum, r.iou_drag_uncompensated, r.iou_drag_compensated
+    );
+    for o in r.occluders.iter().filter(|o| o.launched) {
+        println!(
+            "  {:<12} drag moves it {:>8.1} mm at t; compensated: speed {:+.3} %, COM error {:.2e} mm ({} Newton steps)",
+            o.name,
+            1000.0 * o.position_error_m,
+            o.speed_change_pct,
+            1000.0 * o.compensated_com_error_m,
+            o.newton_iterations
+        );
+    }
+    let m = &r.monte_carlo;
+    let t = &r.tolerances;
+    println!(
+        "  Monte Carlo ({} samples; speed {} %, direction {} deg, spin {} %, timing {} ms, Cd {} %): mean IoU {:.4}, 5th percentile {:.4}, P(IoU >= 0.9) {:.1} %",
+        m.samples, t.speed_pct, t.direction_deg, t.spin_pct, t.timing_ms, t.cd_pct, m.mean, m.p5, 100.0 * m.p_iou_at_least_0_9
+    );
+    if let Some(se) = &r.search {
+        let alone: Vec<String> = se
+            .single
+            .iter()
+            .map(|p| {
+                format!(
+                    "{} {}{:.3} {}",
+                    p.parameter,
+                    if p.at_limit { ">=" } else { "" },
+                    p.largest,
+                    p.unit
+                )
+            })
+            .collect();
+        println!(
+            "  largest tolerances for P(IoU >= 0.9) >= 95 %: alone {}; together x{:.3} of the requested",
+            alone.join(", "),
+            se.joint_scale
+        );
+    }
+    println!(
+        "wrote {}/{{budget.md, budget.json, launch_drag.csv, budget_hist.png{}}} in {elapsed:.2} s",
+        dir.display(),
+        if r.search.is_some() {
+            ", budget_tolerances.png"
+        } else {
+            ""
+        }
+    );
     Ok(())
 }

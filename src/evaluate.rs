@@ -64,6 +64,14 @@ pub struct Workspace {
     table_hit: Vec<Option<f64>>,
 }
 
+impl Workspace {
+    /// Time at which occluder `i` landed on the table (and stayed there) in the last
+    /// [`Problem::fly`], if it did before `t`.
+    pub fn landing_time(&self, i: usize) -> Option<f64> {
+        self.landing[i]
+    }
+}
+
 /// What happened in flight.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Outcome {

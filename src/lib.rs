@@ -8,10 +8,12 @@
 //! -> [`solver`] with [`cmaes`] (stages of CMA-ES) -> [`export`] (files).
 
 pub mod body;
+pub mod budget;
 pub mod cli;
 pub mod cmaes;
 pub mod contact;
 pub mod continuation;
+pub mod drag;
 pub mod energy;
 pub mod evaluate;
 pub mod export;

@@ -827,3 +827,106 @@ fn bad_input_to_export_validate_and_video() {
     let (ok, _, err) = bsa(&["export", out.to_str().unwrap()]);
     assert!(!ok && err.contains("not a valid solution file"), "{err}");
 }
+
+// ---------------------------------------------------------------------------------------
+// Error budget (`bsa budget`)
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn budget_of_a_quick_mickey_solve() {
+    let out = quick_solve(&root().join("scenes/mickey"), "budget");
+    let dir = out.to_str().unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "budget",
+            dir,
+            "--samples",
+            "300",
+            "--search-samples",
+            "40",
+            "-q",
+        ];
+        args.extend_from_slice(extra);
+        bsa(&args)
+    };
+    let (ok, stdout, err) = run(&["--threads", "1"]);
+    assert!(ok, "{err}");
+    assert!(stdout.contains("drag-compensated launch"), "{stdout}");
+    for f in [
+        "budget.md",
+        "budget.json",
+        "launch_drag.csv",
+        "budget_hist.png",
+        "budget_tolerances.png",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let json1 = std::fs::read_to_string(out.join("budget.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&json1).unwrap();
+    for o in v["occluders"].as_array().unwrap() {
+        assert!(o["compensated_com_error_m"].as_f64().unwrap() < 1e-3, "{o}");
+        assert!(o["position_error_m"].as_f64().unwrap() > 0.05, "{o}");
+    }
+    let vac = v["iou_vacuum"].as_f64().unwrap();
+    let comp = v["iou_drag_compensated"].as_f64().unwrap();
+    assert!((vac - comp).abs() <= 0.01, "{vac} vs {comp}");
+    assert_eq!(v["monte_carlo"]["samples"], 300);
+    // Same columns as launch.csv, other velocities.
+    let header = |f: &str| {
+        let mut r = csv::Reader::from_path(out.join(f)).unwrap();
+        let h = r.headers().unwrap().clone();
+        let rows: Vec<csv::StringRecord> = r.records().map(|x| x.unwrap()).collect();
+        (h, rows)
+    };
+    let (h1, r1) = header("launch.csv");
+    let (h2, r2) = header("launch_drag.csv");
+    assert_eq!(h1, h2);
+    assert_eq!(r1.len(), r2.len());
+    let speed = h1.iter().position(|c| c == "speed_m_s").unwrap();
+    for (a, b) in r1.iter().zip(&r2) {
+        let (a, b): (f64, f64) = (a[speed].parse().unwrap(), b[speed].parse().unwrap());
+        assert!(b > a, "drag compensation must launch faster: {a} vs {b}");
+    }
+    // Deterministic whatever the thread count; solution.json given directly works too.
+    let sol = out.join("solution.json");
+    let (ok, _, err) = bsa(&[
+        "budget",
+        sol.to_str().unwrap(),
+        "--samples",
+        "300",
+        "--search-samples",
+        "40",
+        "--threads",
+        "2",
+        "-q",
+    ]);
+    assert!(ok, "{err}");
+    let json2 = std::fs::read_to_string(out.join("budget.json")).unwrap();
+    assert_eq!(json1, json2);
+
+    // Bad input: clear errors, no panic.
+    for (args, expect) in [
+        (vec!["--rho", "-1"], "air density"),
+        (vec!["--cd", "-0.5"], "drag coefficient"),
+        (vec!["--speed-tol", "80"], "speed tolerance"),
+        (vec!["--timing-tol", "-2"], "timing tolerance"),
+        (vec!["--samples", "0"], "samples"),
+    ] {
+        let (ok, _, err) = run(&args);
+        assert!(!ok, "accepted {args:?}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(err.contains(expect), "{args:?}: {err}");
+    }
+    let (ok, _, err) = bsa(&["budget", "scenes", "-q"]);
+    assert!(!ok && err.contains("no solution.json"), "{err}");
+    // A solution of another scene.
+    let other = variant("budget-other", |v| v["name"] = "other".into());
+    let (ok, _, err) = run(&["--scene", other.to_str().unwrap()]);
+    assert!(!ok && err.contains("does not belong"), "{err}");
+    // The same scene, edited after the solve.
+    let edited = variant("budget-edited", |v| {
+        v["occluders"][0]["position"] = serde_json::json!([0.2, -2.0, 0.6])
+    });
+    let (ok, _, err) = run(&["--scene", edited.to_str().unwrap()]);
+    assert!(!ok && err.contains("edited"), "{err}");
+}
