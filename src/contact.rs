@@ -216,6 +216,14 @@ impl ContactShape {
         }
     }
 
+    /// The convex polytope the f64 distance queries use (boxes and meshes).
+    pub fn polytope(&self) -> Option<&Polytope> {
+        match self {
+            ContactShape::Parry(_, _, Some(p)) => Some(p),
+            _ => None,
+        }
+    }
+
     fn parry(&self) -> Option<&dyn ParryShape> {
         match self {
             ContactShape::Ball(_) => None,
@@ -471,16 +479,31 @@ pub fn pair_contact_time(a: &Body, b: &Body, horizon: f64) -> Option<f64> {
         let (pb, qb) = b.motion.pose(s);
         // The covers' gap bounds the distance from below, which is all that
         // conservative advancement needs; the exact query is only needed up close.
-        let d = match cover_gap(a.shape, pa, qa, b.shape, pb, qb) {
-            Some(lb) if lb > COVER_SWITCH => lb,
-            _ => signed_distance_warm(a.shape, pa, qa, b.shape, pb, qb, CA_REL_TOL, &mut warm)
-                .max(0.0),
+        let (d, axis) = match cover_gap(a.shape, pa, qa, b.shape, pb, qb) {
+            Some(lb) if lb > COVER_SWITCH => (lb, None),
+            _ => {
+                let d =
+                    signed_distance_warm(a.shape, pa, qa, b.shape, pb, qb, CA_REL_TOL, &mut warm);
+                (d.max(0.0), warm.axis().map(|n| qa * n))
+            }
         };
         if d <= PAIR_CONTACT_DISTANCE {
             return Some(s);
         }
-        let rel_v = (b.motion.com_velocity(s) - a.motion.com_velocity(s)).length();
-        s += safe_step(d, rel_v + spin, gn);
+        let dv = b.motion.com_velocity(s) - a.motion.com_velocity(s);
+        let approach = match axis {
+            // The bound is the width of the slab between the shapes across the fixed
+            // axis `n` (from b to a): it shrinks no faster than the centres approach
+            // along `n` plus the spin terms (a rotating body's support moves at most
+            // w r), which for a grazing pass is far slower than |dv|.
+            Some(n) => (spin + n.dot(dv)).max(0.0),
+            None => dv.length() + spin,
+        };
+        if approach == 0.0 && gn == 0.0 {
+            // Both fly (no relative gravity) and the slab can only widen: never again.
+            return None;
+        }
+        s += safe_step(d, approach, gn);
         if s > end {
             return None;
         }

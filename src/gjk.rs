@@ -287,6 +287,16 @@ pub fn distance_lower_bound(a: &Polytope, b: &Polytope, rot: DQuat, pos: DVec3) 
 pub struct Warm {
     v: Option<DVec3>,
     ids: (usize, usize),
+    /// Unit axis (in `a`'s frame, pointing from `b` to `a`) along which the last query's
+    /// bound holds: the slab between the two shapes across it is that wide.
+    axis: Option<DVec3>,
+}
+
+impl Warm {
+    /// The separating axis of the last query's bound (see the field), if it was positive.
+    pub fn axis(&self) -> Option<DVec3> {
+        self.axis
+    }
 }
 
 /// [`distance_lower_bound`], starting from (and updating) `warm`, and stopping once the
@@ -325,6 +335,7 @@ pub fn distance_lower_bound_warm(
     let mut n = 1;
     let mut v = w0;
     let mut lower: f64 = 0.0;
+    let mut axis = None;
     let mut result = None;
     for _ in 0..MAX_ITERATIONS {
         let vl2 = v.length_squared();
@@ -335,7 +346,11 @@ pub fn distance_lower_bound_warm(
         let vl = vl2.sqrt();
         let (w, id) = sup(-v);
         // Separating-plane bound: every point x of A - B has v . x >= v . w.
-        lower = lower.max(v.dot(w) / vl);
+        let bound = v.dot(w) / vl;
+        if bound > lower {
+            lower = bound;
+            axis = Some(v / vl);
+        }
         if vl - lower <= ABS_TOL.max(rel_tol * vl) || ids[..n].contains(&id) || n == 4 {
             break;
         }
@@ -365,6 +380,7 @@ pub fn distance_lower_bound_warm(
     }
     warm.v = Some(v);
     warm.ids = ids[0];
+    warm.axis = if result.is_none() { axis } else { None };
     result.unwrap_or(lower.max(0.0))
 }
 

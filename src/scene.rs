@@ -190,6 +190,7 @@ enum RawStrategy {
     Scheduled,
     Sequential {
         order: Option<RawOrder>,
+        rounds: Option<u32>,
         stage: Box<RawStage>,
         #[serde(rename = "final")]
         final_stage: Option<Box<RawStage>>,
@@ -984,7 +985,14 @@ impl Validator<'_> {
                 "stages",
                 "the sequential strategy builds its own stages from `strategy.stage` and `strategy.final`; remove `stages`",
             )),
-            (Some(RawStrategy::Sequential { order, stage, final_stage }), None) => {
+            (Some(RawStrategy::Sequential { order, rounds, stage, final_stage }), None) => {
+                let rounds = match rounds.as_ref() {
+                    None => 1,
+                    Some(&r) if (1..=100).contains(&r) => r as usize,
+                    Some(r) => {
+                        return Err(self.field_err("strategy.rounds", format!("must be 1 to 100, got {r}")))
+                    }
+                };
                 let order: Vec<usize> = match order {
                     None => auto_order(occ),
                     Some(RawOrder::Auto(s)) if s == "auto" => auto_order(occ),
@@ -1012,9 +1020,17 @@ impl Validator<'_> {
                     return Err(self.field_err("strategy.stage.vary", "is set by the sequential strategy (one occluder per stage); remove it"));
                 }
                 let mut stages = Vec::new();
-                for &i in &order {
-                    let s = self.stage("strategy.stage", stage, occ[i].name.clone(), &[i], occ)?;
-                    stages.push(s);
+                for round in 1..=rounds {
+                    for &i in &order {
+                        // Later rounds are told apart in progress and reports.
+                        let name = if round == 1 {
+                            occ[i].name.clone()
+                        } else {
+                            format!("{} ({round})", occ[i].name)
+                        };
+                        let s = self.stage("strategy.stage", stage, name, &[i], occ)?;
+                        stages.push(s);
+                    }
                 }
                 if let Some(fs) = final_stage {
                     stages.push(self.stage("strategy.final", fs, "final".to_string(), &launched, occ)?);

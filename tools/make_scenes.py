@@ -68,7 +68,7 @@ def quat_axis(axis, angle):
     return (axis[0] * s, axis[1] * s, axis[2] * s, math.cos(angle / 2))
 
 
-def make(name, img_w_m, strokes, launch_y, launch_x_span, stage, final, order):
+def make(name, img_w_m, strokes, launch_y, launch_x_span, stage, final, order, rounds=1):
     px = img_w_m / W_PX
     img_h_m = px * H_PX
     occluders, hints = [], []
@@ -134,7 +134,8 @@ def make(name, img_w_m, strokes, launch_y, launch_x_span, stage, final, order):
         "table": {"center": [0.0, 0.0, -0.5], "size": [40.0, 40.0, 1.0]},
         "occluders": occluders,
         "hints": hints,
-        "strategy": {"kind": "sequential", "order": order, "stage": stage, "final": final},
+        "strategy": {"kind": "sequential", "order": order, "rounds": rounds, "stage": stage,
+                     "final": final},
         "seed": 1,
     }
     path = ROOT / "scenes" / name / "scene.json"
@@ -174,7 +175,9 @@ def main():
         ("ku_a", "unit", (556, 160), (468, 232), 22),
         ("ku_b", "unit", (468, 236), (570, 312), 22),
     ]
-    make("tbc", 1.6, tbc, -1.0, 2.8, stage, final, "auto")
+    # Thin strokes leave little slack: a second pass lets early bricks use the room
+    # that later ones left.
+    make("tbc", 1.6, tbc, -1.0, 2.8, stage, final, "auto", rounds=2)
     # THE THINKER adds the boundary terms (as the paper's Table 4 does) and gives each
     # stage more room: sixteen pieces leave each other less slack than bricks do.
     thinker_weights = dict(WEIGHTS, inner=0.5, outer=0.5)
@@ -307,7 +310,8 @@ def make_thinker(stage, final, layout=None):
         "table": {"center": [0.0, 0.0, -0.5], "size": [40.0, 40.0, 1.0]},
         "occluders": occluders,
         "hints": hints,
-        "strategy": {"kind": "sequential", "order": "auto", "stage": stage, "final": final},
+        "strategy": {"kind": "sequential", "order": "auto", "rounds": 2, "stage": stage,
+                     "final": final},
         "seed": 1,
     }
     path = ROOT / "scenes" / "thinker" / "scene.json"
