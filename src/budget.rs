@@ -21,9 +21,12 @@
 //! 4. **Sensitivities** per body by central finite differences (IoU lost and centre-of-
 //!    mass shift per 1 % speed, 1 deg, 1 ms, 1 % spin, 1 % drag coefficient).
 //! 5. **Tolerance search**: the largest size of each error alone, and the largest common
-//!    scale of the requested tolerances, that keep `P(IoU >= 0.9) >= 95 %` (bracketing
-//!    then bisection; every evaluation uses the same random draws, so `P` is a
-//!    deterministic, nearly monotone function of the size).
+//!    scale of the requested tolerances, that keep `P(IoU >= threshold) >= 95 %`
+//!    (bracketing then bisection; every evaluation uses the same random draws, so `P` is
+//!    a deterministic, nearly monotone function of the size). The threshold is
+//!    [`BudgetOptions::iou_threshold`] (default [`IOU_THRESHOLD`], 0.9). When the
+//!    compensated launch without any error is already below it, no launcher precision
+//!    reaches it: the search is skipped and the report says so ([`Unreachable`]).
 //!
 //! The numeric core does not fail: a sample whose flight diverges gets IoU 0 and is
 //! counted in [`IouStats::diverged`]. Contacts are not modelled with drag; a body that
@@ -44,9 +47,10 @@ use crate::energy::{self, Weights};
 use crate::evaluate::{launch_velocities, Problem, Workspace, MAX_TURN};
 use crate::solver::{check_solution, MismatchError, Solution};
 
-/// The IoU a shadow must reach to "read" as the picture.
+/// The default IoU a shadow must reach to "read" as the picture
+/// ([`BudgetOptions::iou_threshold`]).
 pub const IOU_THRESHOLD: f64 = 0.9;
-/// The probability of reaching [`IOU_THRESHOLD`] that the tolerance search keeps.
+/// The probability of reaching the IoU threshold that the tolerance search keeps.
 pub const PROBABILITY_TARGET: f64 = 0.95;
 /// Largest number of Monte Carlo samples accepted.
 pub const MAX_SAMPLES: usize = 10_000_000;
@@ -152,6 +156,9 @@ pub struct BudgetOptions {
     pub seed: u64,
     /// Worker threads (None: one per core). Results do not depend on it.
     pub threads: Option<usize>,
+    /// The IoU a sample must reach to count as a success, in `(0, 1]`. Default
+    /// [`IOU_THRESHOLD`] (0.9).
+    pub iou_threshold: f64,
 }
 
 impl Default for BudgetOptions {
@@ -163,6 +170,7 @@ impl Default for BudgetOptions {
             search_samples: 2_000,
             seed: 1,
             threads: None,
+            iou_threshold: IOU_THRESHOLD,
         }
     }
 }
@@ -188,6 +196,8 @@ pub enum BudgetError {
     },
     #[error("the number of threads must be at least 1")]
     Threads,
+    #[error("the IoU threshold must be greater than 0 and at most 1, got {0}")]
+    Threshold(f64),
     #[error("the launch values hold {found} numbers, the scene needs {expected}")]
     Parameters { expected: usize, found: usize },
     #[error(transparent)]
@@ -323,8 +333,8 @@ pub struct IouStats {
     pub median: f64,
     pub min: f64,
     pub max: f64,
-    /// Fraction of samples with IoU >= [`IOU_THRESHOLD`].
-    pub p_iou_at_least_0_9: f64,
+    /// Fraction of samples with IoU >= the threshold ([`BudgetReport::iou_threshold`]).
+    pub p_iou_at_least_threshold: f64,
     /// Samples whose flight diverged (counted with IoU 0).
     pub diverged: usize,
 }
@@ -340,7 +350,8 @@ fn quantile(sorted: &[f64], p: f64) -> f64 {
 }
 
 impl IouStats {
-    pub fn new(ious: &[f64], diverged: usize) -> IouStats {
+    /// Statistics of `ious`, counting those `>= threshold` as successes.
+    pub fn new(ious: &[f64], diverged: usize, threshold: f64) -> IouStats {
         let mut s = ious.to_vec();
         s.sort_by(f64::total_cmp);
         let n = s.len().max(1) as f64;
@@ -351,7 +362,7 @@ impl IouStats {
             median: quantile(&s, 0.5),
             min: s.first().copied().unwrap_or(f64::NAN),
             max: s.last().copied().unwrap_or(f64::NAN),
-            p_iou_at_least_0_9: ious.iter().filter(|&&x| x >= IOU_THRESHOLD).count() as f64 / n,
+            p_iou_at_least_threshold: ious.iter().filter(|&&x| x >= threshold).count() as f64 / n,
             diverged,
         }
     }
@@ -629,8 +640,12 @@ pub struct BudgetReport {
     pub seed: u64,
     pub drag: DragConfig,
     pub tolerances: Tolerances,
+    /// The IoU a sample must reach ([`BudgetOptions::iou_threshold`]).
     pub iou_threshold: f64,
     pub probability_target: f64,
+    /// Set when the exact compensated launch is already below the threshold (no launcher
+    /// precision can reach it; the tolerance search is skipped); `null` otherwise.
+    pub threshold_unreachable: Option<Unreachable>,
     pub iou_vacuum: f64,
     /// The vacuum launch flown through air.
     pub iou_drag_uncompensated: f64,
@@ -719,7 +734,7 @@ pub struct CurvePoint {
     pub size: f64,
     pub mean: f64,
     pub p5: f64,
-    pub p_iou_at_least_0_9: f64,
+    pub p_iou_at_least_threshold: f64,
 }
 
 /// The largest size of one error alone.
@@ -727,7 +742,7 @@ pub struct CurvePoint {
 pub struct SingleTolerance {
     pub parameter: String,
     pub unit: String,
-    /// Largest 1-sigma size keeping P(IoU >= 0.9) >= 95 % (the others zero).
+    /// Largest 1-sigma size keeping P(IoU >= threshold) >= 95 % (the others zero).
     pub largest: f64,
     /// True when even the accepted limit keeps it (no limit found within range).
     pub at_limit: bool,
@@ -739,10 +754,64 @@ pub struct SingleTolerance {
 pub struct ToleranceSearch {
     pub samples_per_evaluation: usize,
     pub single: Vec<SingleTolerance>,
-    /// Largest common factor on the requested tolerances keeping P(IoU >= 0.9) >= 95 %.
+    /// Largest common factor on the requested tolerances keeping
+    /// P(IoU >= threshold) >= 95 %.
     pub joint_scale: f64,
     pub joint_tolerances: Tolerances,
     pub joint_at_limit: bool,
+}
+
+/// Why the threshold cannot be reached: even the exact compensated launch is below it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Unreachable {
+    /// Which IoUs are below the threshold: `"vacuum"`, `"compensated"` or both.
+    pub below: Vec<String>,
+    /// A threshold the exact compensated launch does reach (the largest multiple of 0.05
+    /// not above the smaller of the vacuum and compensated IoUs), if any.
+    pub suggested_threshold: Option<f64>,
+    /// The explanation printed by the CLI and written to `budget.md`.
+    pub message: String,
+}
+
+impl Unreachable {
+    /// `None` when the exact compensated launch reaches `threshold`. The vacuum IoU below
+    /// the threshold is reported with it; the search is only impossible when the
+    /// compensated IoU is below (what every zero-tolerance sample flies).
+    pub fn check(iou_vacuum: f64, iou_compensated: f64, threshold: f64) -> Option<Unreachable> {
+        if iou_compensated >= threshold {
+            return None;
+        }
+        let mut below = Vec::new();
+        if iou_vacuum < threshold {
+            below.push("vacuum".to_string());
+        }
+        below.push("compensated".to_string());
+        let reach = iou_vacuum.min(iou_compensated);
+        // Rounded so that 0.85 prints as 0.85, then checked against `reach` exactly.
+        let mut suggestion = ((reach * 20.0).floor() / 20.0 * 100.0).round() / 100.0;
+        if suggestion > reach {
+            suggestion -= 0.05;
+        }
+        let suggested_threshold = (suggestion > 0.0).then_some(suggestion);
+        let what = if iou_vacuum < threshold {
+            format!("the vacuum solution reaches IoU {iou_vacuum:.4} < threshold {threshold}")
+        } else {
+            format!(
+                "the vacuum solution reaches IoU {iou_vacuum:.4} but the drag-compensated launch only {iou_compensated:.4} < threshold {threshold}"
+            )
+        };
+        let message = match suggested_threshold {
+            Some(s) => format!(
+                "{what}: no launcher precision can reach it (P(IoU >= {threshold}) is 0 at any tolerance); rerun with --iou-threshold {s}"
+            ),
+            None => format!("{what}: no launcher precision can reach it"),
+        };
+        Some(Unreachable {
+            below,
+            suggested_threshold,
+            message,
+        })
+    }
 }
 
 /// The result of [`run`].
@@ -788,6 +857,9 @@ pub fn validate_options(problem: &Problem, opts: &BudgetOptions) -> Result<(), B
     }
     if opts.threads == Some(0) {
         return Err(BudgetError::Threads);
+    }
+    if !(opts.iou_threshold > 0.0 && opts.iou_threshold <= 1.0) {
+        return Err(BudgetError::Threshold(opts.iou_threshold));
     }
     Ok(())
 }
@@ -869,14 +941,17 @@ pub fn run(
         progress,
     );
     progress.finish();
-    let monte_carlo = IouStats::new(&ious, diverged);
+    let monte_carlo = IouStats::new(&ious, diverged, opts.iou_threshold);
+    let threshold_unreachable = Unreachable::check(b.vacuum_iou, iou_comp, opts.iou_threshold);
     let histogram = Histogram::new(&ious, 50);
 
     // 4. Sensitivities.
     let sensitivity = sensitivities(&b, &comp, iou_comp, &pool);
 
     // 5. Tolerance search.
-    let search = (opts.search_samples > 0).then(|| search(&b, &comp, opts, &pool, progress));
+    // 5. Tolerance search (pointless when even an exact launch misses the threshold).
+    let search = (opts.search_samples > 0 && threshold_unreachable.is_none())
+        .then(|| search(&b, &comp, opts, &pool, progress));
 
     let mut notes = vec![
         "Drag torque is neglected: the orientation at t is the exact torque-free one, so the orientation error is 0 by construction.".to_string(),
@@ -891,6 +966,17 @@ pub fn run(
             ));
         }
     }
+    if let Some(u) = &threshold_unreachable {
+        notes.push(format!(
+            "Threshold unreachable: {}. The tolerance search was skipped.",
+            u.message
+        ));
+    } else if b.vacuum_iou < opts.iou_threshold {
+        notes.push(format!(
+            "The vacuum solution reaches IoU {:.4} < threshold {}, but the drag-compensated launch reaches {:.4}.",
+            b.vacuum_iou, opts.iou_threshold, iou_comp
+        ));
+    }
     if diverged > 0 {
         notes.push(format!(
             "{diverged} Monte Carlo samples diverged and count with IoU 0."
@@ -902,8 +988,9 @@ pub fn run(
         seed: opts.seed,
         drag: opts.drag,
         tolerances: opts.tolerances,
-        iou_threshold: IOU_THRESHOLD,
+        iou_threshold: opts.iou_threshold,
         probability_target: PROBABILITY_TARGET,
+        threshold_unreachable,
         iou_vacuum: b.vacuum_iou,
         iou_drag_uncompensated: iou_drag,
         iou_drag_compensated: iou_comp,
@@ -1056,9 +1143,9 @@ fn search(
     let user = opts.tolerances.to_array();
     let stats = |tol: &Tolerances| {
         let (ious, diverged) = b.monte_carlo(comp, tol, m, seed, pool, &());
-        IouStats::new(&ious, diverged)
+        IouStats::new(&ious, diverged, opts.iou_threshold)
     };
-    let ok = |s: &IouStats| s.p_iou_at_least_0_9 >= PROBABILITY_TARGET;
+    let ok = |s: &IouStats| s.p_iou_at_least_threshold >= PROBABILITY_TARGET;
     progress.start("tolerance search", 6);
     let mut single = Vec::new();
     for (p, (name, unit, _)) in PARAMETERS.iter().enumerate() {
@@ -1078,7 +1165,7 @@ fn search(
                     size,
                     mean: s.mean,
                     p5: s.p5,
-                    p_iou_at_least_0_9: s.p_iou_at_least_0_9,
+                    p_iou_at_least_threshold: s.p_iou_at_least_threshold,
                 }
             })
             .collect();
@@ -1141,6 +1228,9 @@ impl BudgetReport {
             "| IoU at t | vacuum | vacuum launch in air | compensated launch in air |\n|---|---|---|---|\n| | {:.4} | {:.4} | {:.4} |\n",
             self.iou_vacuum, self.iou_drag_uncompensated, self.iou_drag_compensated
         );
+        if let Some(u) = &self.threshold_unreachable {
+            let _ = writeln!(s, "**Threshold unreachable:** {}.\n", u.message);
+        }
         let _ = writeln!(s, "| occluder | shape | Cd | A (m^2) | k (1/m) | v_T (m/s) | drag moves it by (mm) | orientation error (rad) | speed change (%) | compensated COM error (mm) | Newton it. |");
         let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
         for o in &self.occluders {
@@ -1188,7 +1278,7 @@ impl BudgetReport {
             m.p5,
             m.median,
             m.min,
-            100.0 * m.p_iou_at_least_0_9,
+            100.0 * m.p_iou_at_least_threshold,
             m.diverged
         );
         let _ = writeln!(s, "![IoU histogram](budget_hist.png)\n");
@@ -1212,6 +1302,15 @@ impl BudgetReport {
                 r.mm_per_deg,
                 r.mm_per_ms,
                 r.mm_per_pct_cd
+            );
+        }
+        if let Some(u) = &self.threshold_unreachable {
+            let _ = writeln!(
+                s,
+                "\n## Largest tolerances keeping P(IoU >= {}) >= {} %\n\nUnreachable at any tolerance, so not searched: {}.\n",
+                self.iou_threshold,
+                100.0 * self.probability_target,
+                u.message
             );
         }
         if let Some(se) = &self.search {
@@ -1421,6 +1520,99 @@ mod tests {
     }
 
     #[test]
+    fn default_threshold_is_0_9() {
+        assert_eq!(BudgetOptions::default().iou_threshold, 0.9);
+        assert_eq!(IOU_THRESHOLD, 0.9);
+        let p = mickey();
+        let mut o = small_options(2);
+        o.search_samples = 0;
+        let a = run(&p, &MICKEY, &o, &()).unwrap();
+        let r = &a.report;
+        assert_eq!(r.iou_threshold, 0.9);
+        assert!(r.threshold_unreachable.is_none());
+        let frac = a.ious.iter().filter(|&&x| x >= 0.9).count() as f64 / a.ious.len() as f64;
+        assert_eq!(r.monte_carlo.p_iou_at_least_threshold, frac);
+        let md = r.markdown();
+        assert!(md.contains("P(IoU >= 0.9)"), "{md}");
+        assert!(!md.contains("nreachable"), "{md}");
+        let v = serde_json::to_value(r).unwrap();
+        assert_eq!(v["iou_threshold"], 0.9);
+        assert!(v["threshold_unreachable"].is_null());
+        assert!(v["monte_carlo"]["p_iou_at_least_threshold"].is_number());
+        // A lower threshold counts more successes on the same draws.
+        o.iou_threshold = 0.8;
+        let b = run(&p, &MICKEY, &o, &()).unwrap();
+        assert_eq!(a.ious, b.ious);
+        assert!(
+            b.report.monte_carlo.p_iou_at_least_threshold >= r.monte_carlo.p_iou_at_least_threshold
+        );
+    }
+
+    #[test]
+    fn threshold_above_the_vacuum_iou_is_reported_unreachable() {
+        let p = mickey();
+        let b = Budget::new(&p, &MICKEY, DragConfig::default()).unwrap();
+        assert!(
+            b.vacuum_iou < 0.999 && b.vacuum_iou > 0.95,
+            "{}",
+            b.vacuum_iou
+        );
+        let mut o = small_options(2);
+        o.iou_threshold = 0.999;
+        let r = run(&p, &MICKEY, &o, &()).unwrap().report;
+        let u = r
+            .threshold_unreachable
+            .as_ref()
+            .expect("reported reachable");
+        assert_eq!(u.below, ["vacuum", "compensated"]);
+        assert_eq!(u.suggested_threshold, Some(0.95));
+        assert!(u.message.contains("no launcher precision"), "{}", u.message);
+        assert!(u.message.contains("--iou-threshold 0.95"), "{}", u.message);
+        assert!(r.search.is_none(), "searched an unreachable threshold");
+        assert_eq!(r.monte_carlo.p_iou_at_least_threshold, 0.0);
+        let md = r.markdown();
+        assert!(md.contains("Threshold unreachable"), "{md}");
+        assert!(md.contains("Unreachable at any tolerance"), "{md}");
+        assert!(md.contains("P(IoU >= 0.999)"), "{md}");
+        let v = serde_json::to_value(&r).unwrap();
+        assert_eq!(v["iou_threshold"], 0.999);
+        assert!(v["search"].is_null());
+        assert_eq!(v["threshold_unreachable"]["suggested_threshold"], 0.95);
+        // The same at a reachable threshold: searched, nothing unreachable.
+        o.iou_threshold = 0.95;
+        let r = run(&p, &MICKEY, &o, &()).unwrap().report;
+        assert!(r.threshold_unreachable.is_none());
+        assert!(r.search.is_some());
+
+        // The rules of the check itself.
+        assert!(Unreachable::check(0.95, 0.95, 0.95).is_none());
+        assert!(Unreachable::check(0.87, 0.91, 0.9).is_none());
+        let u = Unreachable::check(0.87, 0.87, 0.9).unwrap();
+        assert_eq!(u.suggested_threshold, Some(0.85));
+        assert!(
+            u.message
+                .starts_with("the vacuum solution reaches IoU 0.8700 < threshold 0.9"),
+            "{}",
+            u.message
+        );
+        let u = Unreachable::check(0.92, 0.86, 0.9).unwrap();
+        assert_eq!(u.below, ["compensated"]);
+        assert_eq!(u.suggested_threshold, Some(0.85));
+        assert_eq!(
+            Unreachable::check(0.85, 0.85, 0.9)
+                .unwrap()
+                .suggested_threshold,
+            Some(0.85)
+        );
+        assert_eq!(
+            Unreachable::check(0.03, 0.03, 0.9)
+                .unwrap()
+                .suggested_threshold,
+            None
+        );
+    }
+
+    #[test]
     fn sensitivities_and_search_are_sane() {
         let p = mickey();
         let r = run(&p, &MICKEY, &small_options(2), &()).unwrap().report;
@@ -1435,7 +1627,7 @@ mod tests {
         assert!(speed.largest > 0.0 && !speed.at_limit);
         assert!(se.single[2].at_limit, "spin of spheres never matters");
         for c in &speed.curve {
-            assert!((0.0..=1.0).contains(&c.p_iou_at_least_0_9));
+            assert!((0.0..=1.0).contains(&c.p_iou_at_least_threshold));
         }
     }
 
@@ -1511,6 +1703,21 @@ mod tests {
             ..good.clone()
         });
         assert!(matches!(e, BudgetError::Threads));
+        for x in [0.0, -0.1, 1.0 + 1e-9, 1.5, f64::NAN, f64::INFINITY] {
+            let (msg, e) = bad(BudgetOptions {
+                iou_threshold: x,
+                ..good.clone()
+            });
+            assert!(matches!(e, BudgetError::Threshold(_)), "{msg}");
+            assert!(msg.contains("IoU threshold"), "{msg}");
+        }
+        for x in [1e-6, 0.5, 0.85, 1.0] {
+            let o = BudgetOptions {
+                iou_threshold: x,
+                ..good.clone()
+            };
+            assert!(validate_options(&p, &o).is_ok(), "{x}");
+        }
         let e = Budget::new(&p, &MICKEY[..12], DragConfig::default())
             .err()
             .unwrap();

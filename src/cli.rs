@@ -155,6 +155,10 @@ enum Command {
         /// Drag coefficient error, 1 sigma (% of Cd).
         #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
         cd_tol: f64,
+        /// IoU a sample must reach to count as a success, in (0, 1]: the Monte Carlo
+        /// reports P(IoU >= X) and the tolerance search keeps it >= 95 %.
+        #[arg(long, value_name = "X", default_value_t = crate::budget::IOU_THRESHOLD, allow_negative_numbers = true)]
+        iou_threshold: f64,
         /// No progress bars.
         #[arg(long, short)]
         quiet: bool,
@@ -223,6 +227,7 @@ pub fn run(cli: Cli) -> Result<()> {
             spin_tol,
             timing_tol,
             cd_tol,
+            iou_threshold,
             quiet,
         } => {
             let mut drag = crate::drag::DragConfig {
@@ -246,6 +251,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 search_samples,
                 seed,
                 threads,
+                iou_threshold,
             };
             budget(&path, scene.as_deref(), &opts, quiet)
         }
@@ -1060,13 +1066,15 @@ fn budget(
     let hist = picture::histogram_plot(
         &format!("{}: IoU at t, {} samples", r.scene, r.monte_carlo.samples),
         &format!(
-            "IoU (red: 0.9; P(IoU >= 0.9) = {:.1} %)",
-            100.0 * r.monte_carlo.p_iou_at_least_0_9
+            "IoU (red: {}; P(IoU >= {}) = {:.1} %)",
+            r.iou_threshold,
+            r.iou_threshold,
+            100.0 * r.monte_carlo.p_iou_at_least_threshold
         ),
         h.lo,
         h.hi,
         &h.counts,
-        Some(budget::IOU_THRESHOLD),
+        Some(r.iou_threshold),
         640,
         400,
     );
@@ -1095,9 +1103,9 @@ fn budget(
                             points: pts(&|c| c.p5),
                         },
                         Series {
-                            name: "P(IoU>=0.9)".into(),
+                            name: format!("P(IoU>={})", r.iou_threshold),
                             color: picture::RED,
-                            points: pts(&|c| c.p_iou_at_least_0_9),
+                            points: pts(&|c| c.p_iou_at_least_threshold),
                         },
                     ],
                     (0.0, 1.0),
@@ -1112,6 +1120,13 @@ fn budget(
             &picture::side_by_side(&refs, 0),
             &dir.join("budget_tolerances.png"),
         )?;
+    } else {
+        // No search this time: a plot left by an earlier run would not match budget.json.
+        let stale = dir.join("budget_tolerances.png");
+        if stale.is_file() {
+            std::fs::remove_file(&stale)
+                .with_context(|| format!("removing the stale {}", stale.display()))?;
+        }
     }
 
     println!(
@@ -1131,9 +1146,13 @@ fn budget(
     let m = &r.monte_carlo;
     let t = &r.tolerances;
     println!(
-        "  Monte Carlo ({} samples; speed {} %, direction {} deg, spin {} %, timing {} ms, Cd {} %): mean IoU {:.4}, 5th percentile {:.4}, P(IoU >= 0.9) {:.1} %",
-        m.samples, t.speed_pct, t.direction_deg, t.spin_pct, t.timing_ms, t.cd_pct, m.mean, m.p5, 100.0 * m.p_iou_at_least_0_9
+        "  Monte Carlo ({} samples; speed {} %, direction {} deg, spin {} %, timing {} ms, Cd {} %): mean IoU {:.4}, 5th percentile {:.4}, P(IoU >= {}) {:.1} %",
+        m.samples, t.speed_pct, t.direction_deg, t.spin_pct, t.timing_ms, t.cd_pct, m.mean, m.p5, r.iou_threshold, 100.0 * m.p_iou_at_least_threshold
     );
+    if let Some(u) = &r.threshold_unreachable {
+        println!("  threshold unreachable: {}", u.message);
+        println!("  largest tolerances: none (not searched: no launcher precision reaches the threshold)");
+    }
     if let Some(se) = &r.search {
         let alone: Vec<String> = se
             .single
@@ -1149,7 +1168,9 @@ fn budget(
             })
             .collect();
         println!(
-            "  largest tolerances for P(IoU >= 0.9) >= 95 %: alone {}; together x{:.3} of the requested",
+            "  largest tolerances for P(IoU >= {}) >= {} %: alone {}; together x{:.3} of the requested",
+            r.iou_threshold,
+            100.0 * r.probability_target,
             alone.join(", "),
             se.joint_scale
         );

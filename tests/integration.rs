@@ -857,12 +857,32 @@ fn budget_of_a_quick_mickey_solve() {
         "budget.json",
         "launch_drag.csv",
         "budget_hist.png",
-        "budget_tolerances.png",
     ] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
     let json1 = std::fs::read_to_string(out.join("budget.json")).unwrap();
     let v: serde_json::Value = serde_json::from_str(&json1).unwrap();
+    // The quick solve may stay below the threshold: then no search and no plot of it.
+    let reachable = v["threshold_unreachable"].is_null();
+    assert_eq!(reachable, out.join("budget_tolerances.png").is_file());
+    assert_eq!(reachable, !v["search"].is_null());
+    assert_eq!(
+        reachable,
+        !stdout.contains("threshold unreachable"),
+        "{stdout}"
+    );
+    // A threshold above any IoU: reported unreachable, clearly, and not searched.
+    let (ok, stdout, err) = run(&["--iou-threshold", "1"]);
+    assert!(ok, "{err}");
+    assert!(stdout.contains("threshold unreachable"), "{stdout}");
+    assert!(stdout.contains("no launcher precision"), "{stdout}");
+    let v1: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("budget.json")).unwrap()).unwrap();
+    assert_eq!(v1["iou_threshold"], 1.0);
+    assert!(v1["search"].is_null() && !v1["threshold_unreachable"].is_null());
+    assert!(!out.join("budget_tolerances.png").is_file());
+    let md = std::fs::read_to_string(out.join("budget.md")).unwrap();
+    assert!(md.contains("Unreachable at any tolerance"), "{md}");
     for o in v["occluders"].as_array().unwrap() {
         assert!(o["compensated_com_error_m"].as_f64().unwrap() < 1e-3, "{o}");
         assert!(o["position_error_m"].as_f64().unwrap() > 0.05, "{o}");
@@ -871,6 +891,13 @@ fn budget_of_a_quick_mickey_solve() {
     let comp = v["iou_drag_compensated"].as_f64().unwrap();
     assert!((vac - comp).abs() <= 0.01, "{vac} vs {comp}");
     assert_eq!(v["monte_carlo"]["samples"], 300);
+    // The default threshold is 0.9, recorded; P(IoU >= threshold) is a probability.
+    assert_eq!(v["iou_threshold"], 0.9);
+    let p = v["monte_carlo"]["p_iou_at_least_threshold"]
+        .as_f64()
+        .unwrap();
+    assert!((0.0..=1.0).contains(&p), "{p}");
+    assert!(v["monte_carlo"].get("p_iou_at_least_0_9").is_none());
     // Same columns as launch.csv, other velocities.
     let header = |f: &str| {
         let mut r = csv::Reader::from_path(out.join(f)).unwrap();
@@ -911,6 +938,9 @@ fn budget_of_a_quick_mickey_solve() {
         (vec!["--speed-tol", "80"], "speed tolerance"),
         (vec!["--timing-tol", "-2"], "timing tolerance"),
         (vec!["--samples", "0"], "samples"),
+        (vec!["--iou-threshold", "0"], "IoU threshold"),
+        (vec!["--iou-threshold", "1.2"], "IoU threshold"),
+        (vec!["--iou-threshold", "-0.5"], "IoU threshold"),
     ] {
         let (ok, _, err) = run(&args);
         assert!(!ok, "accepted {args:?}");
