@@ -5,7 +5,14 @@
 //! - `sample_mickey_stage2`: one Mickey sample on one core (flight, contacts, shadow,
 //!   every term of stage 2; target <= 50 us).
 //! - `sample_mickey_all_terms`: the same with all ten terms on.
+//! - `sample_thinker_start_all_terms`: one sample of THE THINKER on one core: 16 chess
+//!   pieces (10,946 triangles) in flight, every pair and the table checked for contact,
+//!   the exact shadow of every mesh, all ten terms; at the scene's start guess, every
+//!   piece launched (target <= 1 ms).
 //! - `solve_mickey_2_threads`: the whole two-stage Mickey solve on 2 threads (target <= 5 s).
+//!
+//! The wall times of the fly, tbc and thinker solves (targets 10 s, 27 s, 4 min) are
+//! measured by `scripts/bench-solves.sh`: each takes too long for criterion's repeats.
 //! - `budget_mickey_10k_2_threads`: the error budget's Monte Carlo, 10,000 samples of the
 //!   drag-compensated Mickey launch in air at the default tolerances, on 2 threads
 //!   (target <= 10 s).
@@ -49,6 +56,14 @@ fn benches(c: &mut Criterion) {
     let all = Weights::all_ones();
     c.bench_function("sample_mickey_all_terms", |b| {
         b.iter(|| black_box(p.evaluate(black_box(&NEAR_SOLUTION), &all, &mut ws)))
+    });
+
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/thinker");
+    let thinker = Problem::new(bsa::scene::load(&dir).expect("scenes/thinker loads"));
+    let start = thinker.scene.start_parameters();
+    let mut tws = thinker.workspace();
+    c.bench_function("sample_thinker_start_all_terms", |b| {
+        b.iter(|| black_box(thinker.evaluate(black_box(&start), &all, &mut tws)))
     });
 
     let mut group = c.benchmark_group("solve");

@@ -899,6 +899,13 @@ fn eval(
         let b = j.map_or_else(|| "table".to_string(), |j| scene.occluders[j].name.clone());
         (a, b)
     });
+    let outside: Vec<&str> = problem
+        .shadows_in_image(&ws)
+        .iter()
+        .zip(&scene.occluders)
+        .filter(|(inside, _)| !**inside)
+        .map(|(_, o)| o.name.as_str())
+        .collect();
     let timings = match profile {
         Some(reps) => problem.profile(&s.parameters(), reps.max(1), &mut ws),
         None => Vec::new(),
@@ -922,6 +929,7 @@ fn eval(
             "t_sim": e.outcome.t_sim,
             "n_contacts": e.outcome.n_contacts,
             "first_contact": first_contact.as_ref().map(|(a, b)| [a, b]),
+            "shadows_outside_image": outside,
             "time_per_phase_us": timings.iter().map(|(k, v)| (k.clone(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
         });
         println!("{}", serde_json::to_string_pretty(&v)?);
@@ -946,6 +954,14 @@ fn eval(
         );
         if let Some((a, b)) = &first_contact {
             println!("first contact: `{a}` with `{b}`");
+        }
+        if outside.is_empty() {
+            println!(
+                "every occluder's shadow lies in the image ({} occluders)",
+                scene.occluders.len()
+            );
+        } else {
+            println!("shadows leaving the image: {}", outside.join(", "));
         }
         if !timings.is_empty() {
             println!("time per sample phase (one core, microseconds):");

@@ -451,6 +451,50 @@ impl Problem {
         raw[Term::Barrier as usize] = barrier;
     }
 
+    /// Whether each occluder's shadow at `t` (poses from the last sample in `ws`) lies
+    /// entirely inside the image. For boxes and meshes, every vertex must project inside
+    /// (the shadow is within the hull of the projected vertices); for spheres, 4,096 points
+    /// spread over the surface (Fibonacci lattice) must, with half a pixel to spare for
+    /// the gaps between them. Geometry at or behind the light plane counts as outside.
+    pub fn shadows_in_image(&self, ws: &Workspace) -> Vec<bool> {
+        let cam = &self.scene.camera;
+        let (w, h) = (cam.width_px as f64, cam.height_px as f64);
+        let inside = |p: DVec3, margin: f64| {
+            cam.project(p).is_some_and(|px| {
+                px.x >= margin && px.y >= margin && px.x <= w - margin && px.y <= h - margin
+            })
+        };
+        self.scene
+            .occluders
+            .iter()
+            .enumerate()
+            .map(|(i, o)| {
+                let (p, q) = ws.poses[i];
+                match &o.shape {
+                    Shape::Sphere { radius } => {
+                        const N: usize = 4096;
+                        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+                        (0..N).all(|k| {
+                            let z = 1.0 - 2.0 * (k as f64 + 0.5) / N as f64;
+                            let r = (1.0 - z * z).sqrt();
+                            let a = golden * k as f64;
+                            inside(p + *radius * DVec3::new(r * a.cos(), r * a.sin(), z), 0.5)
+                        })
+                    }
+                    Shape::Cuboid { half_extents } => (0..8).all(|k| {
+                        let s = DVec3::new(
+                            if k & 1 != 0 { 1.0 } else { -1.0 },
+                            if k & 2 != 0 { 1.0 } else { -1.0 },
+                            if k & 4 != 0 { 1.0 } else { -1.0 },
+                        );
+                        inside(p + q * (s * *half_extents), 0.0)
+                    }),
+                    Shape::Mesh(m) => m.vertices.iter().all(|v| inside(p + q * *v, 0.0)),
+                }
+            })
+            .collect()
+    }
+
     /// Full parameter vector from a stage's varying subset.
     pub fn expand(&self, base: &[f64], vary: &[usize], x: &[f64], out: &mut [f64]) {
         out.copy_from_slice(base);
@@ -508,5 +552,42 @@ impl Problem {
         });
         out.push(("sample (all terms)".into(), us));
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(name: &str) -> Problem {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join(name);
+        Problem::new(crate::scene::load(&dir).expect("example scene loads"))
+    }
+
+    #[test]
+    fn shadows_in_image_tells_a_shadow_cut_by_the_image_edge() {
+        for name in ["mickey", "thinker"] {
+            let p = scene(name);
+            let mut ws = p.workspace();
+            p.evaluate(&p.scene.start_parameters(), &Weights::all_ones(), &mut ws);
+            let n = p.scene.occluders.len();
+            // Every body 1 m above the image centre: all inside.
+            for pose in ws.poses.iter_mut() {
+                *pose = (DVec3::new(0.0, 0.0, 1.0), DQuat::IDENTITY);
+            }
+            assert_eq!(p.shadows_in_image(&ws), vec![true; n], "{name}");
+            // The first body moved so that its shadow straddles the right edge.
+            let cam = &p.scene.camera;
+            let edge = cam.pixel_to_world(cam.width_px as f64, 0.5 * cam.height_px as f64);
+            ws.poses[0].0 = edge * (1.0 - 1.0 / cam.light_height()) + DVec3::new(0.0, 0.0, 1.0);
+            let inside = p.shadows_in_image(&ws);
+            assert!(!inside[0], "{name}: a shadow across the edge is not inside");
+            assert!(inside[1..].iter().all(|&b| b), "{name}");
+            // Behind the light plane: outside.
+            ws.poses[0].0 = DVec3::new(0.0, 0.0, cam.light_height() + 1.0);
+            assert!(!p.shadows_in_image(&ws)[0], "{name}");
+        }
     }
 }

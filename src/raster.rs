@@ -1773,4 +1773,70 @@ mod tests {
         });
         println!("  (checksum {sink})");
     }
+
+    /// The silhouette path must give the same pixels as filling every front face, for
+    /// the chess pieces (curved, many near-silhouette faces) at random poses, including
+    /// poses that straddle the receiver or the light plane (where it falls back).
+    #[test]
+    fn silhouette_fill_matches_the_triangle_fill_on_chess_pieces() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/thinker/pieces");
+        let cam = ShadowCamera::new(
+            DVec3::new(0.0, 0.0, 3.0),
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::Y,
+            0.96,
+            0.72,
+            640,
+            480,
+        );
+        let mut rng = Rng(11);
+        let mut scratch = RasterScratch::default();
+        let mut world = Vec::new();
+        let (mut a, mut b) = (Mask::new(640, 480), Mask::new(640, 480));
+        let mut compared = 0u64;
+        for piece in ["pawn", "rook", "knight", "bishop", "queen", "king"] {
+            let mesh =
+                crate::body::load_obj(&dir.join(format!("{piece}.obj")), 1.0).expect("piece");
+            let sil =
+                MeshSilhouette::new(&mesh.vertices, &mesh.triangles).expect("closed, oriented");
+            for k in 0..40 {
+                // Mostly inside the slab, some across the receiver (z near 0) or the light.
+                let z = match k % 8 {
+                    0 => rng.uniform(-0.05, 0.05),
+                    1 => rng.uniform(2.95, 3.05),
+                    _ => rng.uniform(0.3, 2.6),
+                };
+                let p = DVec3::new(rng.uniform(-0.3, 0.3), rng.uniform(-0.25, 0.25), z);
+                let q = rng.rotation();
+                a.clear();
+                b.clear();
+                cam.rasterize_mesh(
+                    p,
+                    q,
+                    &mesh.vertices,
+                    &mesh.triangles,
+                    &sil,
+                    &mut world,
+                    &mut a,
+                    &mut scratch,
+                );
+                world.clear();
+                world.extend(mesh.vertices.iter().map(|v| p + q * *v));
+                cam.rasterize_triangles(&world, &mesh.triangles, true, &mut b, &mut scratch);
+                assert_eq!(
+                    a.xor_count(&b),
+                    0,
+                    "{piece} at {p} {q}: {} vs {} pixels",
+                    a.count(),
+                    b.count()
+                );
+                compared += b.count();
+            }
+        }
+        assert!(
+            compared > 100_000,
+            "the poses must cast real shadows ({compared} px)"
+        );
+    }
 }

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Wall time of the example solves, the paper's Table 3 "total running time":
+#
+#     bash scripts/bench-solves.sh [seeds...]      # default seeds: 1 2 3
+#
+# Builds the release binary, then solves every scene under scenes/ once per seed on all
+# cores (results in /tmp/bsa-bench/<scene>-<seed>/, not in export/) and prints one line
+# per solve: IoU at t, contacts, samples, iterations and the solver's own wall time.
+# Targets (issue "four examples"): mickey <= 5 s, fly <= 10 s, tbc <= 27 s,
+# thinker <= 4 min on 2 cores.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seeds=("$@")
+[ ${#seeds[@]} -eq 0 ] && seeds=(1 2 3)
+cargo build --release --locked --quiet
+mkdir -p /tmp/bsa-bench
+for dir in scenes/*/; do
+    [ -f "$dir/scene.json" ] || continue
+    name=$(basename "$dir")
+    for seed in "${seeds[@]}"; do
+        out=/tmp/bsa-bench/$name-$seed
+        ./target/release/bsa solve "$dir" --seed "$seed" --out "$out" -q --report >"$out.log" 2>&1 ||
+            { echo "$name seed $seed: solve failed, see $out.log"; exit 1; }
+        echo "seed $seed  $(grep -E "^$name: IoU" "$out.log")"
+    done
+done
