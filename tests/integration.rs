@@ -464,6 +464,58 @@ fn sequential_strategy_varies_one_occluder_per_stage_then_all() {
     }
 }
 
+#[test]
+fn sequential_rounds_repeat_the_pass_and_are_checked() {
+    let with_rounds = |rounds: serde_json::Value| {
+        variant("rounds", move |v| {
+            let mut stage = v["stages"][1].clone();
+            v.as_object_mut().unwrap().remove("stages");
+            stage.as_object_mut().unwrap().remove("name");
+            v["strategy"] = serde_json::json!({
+                "kind": "sequential", "order": ["left_ear", "head"], "rounds": rounds,
+                "stage": stage, "final": stage
+            });
+        })
+    };
+    let scene = bsa::scene::load(&with_rounds(2.into())).unwrap();
+    let names: Vec<&str> = scene.stages.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["left_ear", "head", "left_ear (2)", "head (2)", "final"]
+    );
+    assert_eq!(scene.stages[2].vary, vec![1]);
+    for bad in [0, 101] {
+        let err = bsa::scene::load(&with_rounds(bad.into())).unwrap_err();
+        let msg = format!("{err:#}");
+        assert!(
+            msg.contains("strategy.rounds") && msg.contains("1 to 100"),
+            "{msg}"
+        );
+    }
+}
+
+#[test]
+fn example_scenes_start_without_contact_near_their_targets() {
+    // The generator (tools/make_scenes.py) promises start guesses that fly without
+    // contact; the solver's sequential stages rely on it (a held pair that collides hides
+    // every later contact from the stage's penalty).
+    for name in ["fly", "tbc", "thinker"] {
+        let p = Problem::new(bsa::scene::load(&root().join("scenes").join(name)).unwrap());
+        let mut ws = p.workspace();
+        let e = p.evaluate(
+            &p.scene.start_parameters(),
+            &bsa::energy::Weights::all_ones(),
+            &mut ws,
+        );
+        assert_eq!(
+            e.outcome.n_contacts, 0,
+            "{name}: {:?}",
+            e.outcome.first_contact
+        );
+        assert!(e.iou > 0.5, "{name}: start IoU {}", e.iou);
+    }
+}
+
 /// Raises the interrupt counter to 2 in the middle of the first stage (a double Ctrl-C).
 struct StopMidFirstStage<'a>(&'a AtomicUsize);
 impl Observer for StopMidFirstStage<'_> {
