@@ -34,12 +34,15 @@ use crate::scene::{Occluder, Table};
 
 /// Surfaces closer than this (m) are in contact.
 pub const CONTACT_DISTANCE: f64 = 1e-6;
-/// Two bodies whose distance, found by conservative advancement, falls to this (m) are in
-/// contact. Conservative advancement never steps over a contact, but a pass that grazes
-/// at a distance `d` for a while costs it about `rate / d` distance queries per second of
-/// grazing, and the optimizer is drawn to such passes (neighbouring pieces' shadows want
-/// to overlap). A near miss within 0.1 mm is a contact for any real launch, and counting
-/// it as one bounds the work per pass.
+/// Tolerance band (m) of the contact search between two bodies other than spheres: a
+/// contact (distance 0) is never missed, and the search stops, reporting a contact, at the
+/// first step at which the distance is within this band. So a near miss closer than
+/// 0.1 mm may count as a contact (whether it does depends on where the steps land), and
+/// the reported time lies between the first moment within 0.1 mm and the touch.
+/// Conservative advancement never steps over a contact, but a pass that grazes at a
+/// distance `d` costs it about `rate / d` queries per second of grazing, and the
+/// optimizer is drawn to such passes (neighbouring pieces' shadows want to overlap); the
+/// band bounds that work. A near miss within 0.1 mm is a contact for any real launch.
 pub const PAIR_CONTACT_DISTANCE: f64 = 1e-4;
 /// A body resting on the table at launch may sink this far (m) into it before that
 /// counts as a contact (it is launched from touching contact, distance 0).
@@ -372,18 +375,32 @@ fn signed_distance_warm(
             // ball is its centre, its radius subtracted). Only a penetration depth,
             // needed for bodies that touch at launch, comes from parry.
             let (va, vb) = (hull_points(sa), hull_points(sb));
-            if let (Some(va), Some(vb)) = (va, vb) {
-                let d = crate::gjk::distance_lower_bound_warm(va, vb, rel_q, rel_p, rel_tol, warm)
-                    - ball_radius(sa)
-                    - ball_radius(sb);
-                if d > CONTACT_DISTANCE {
-                    return d;
+            let certified = match (va, vb) {
+                (Some(va), Some(vb)) => {
+                    let d =
+                        crate::gjk::distance_lower_bound_warm(va, vb, rel_q, rel_p, rel_tol, warm)
+                            - ball_radius(sa)
+                            - ball_radius(sb);
+                    if d > CONTACT_DISTANCE {
+                        return d;
+                    }
+                    Some(d)
                 }
-            }
-            match query::contact(&pose_a, ga, &pose_b, gb, f32::MAX) {
-                Ok(Some(c)) => c.dist as f64,
+                _ => None,
+            };
+            // Touching or overlapping: parry gives the penetration depth. It is never
+            // trusted to raise the certified bound: on curved hulls its f32 GJK was seen to
+            // report millimetres of clearance for overlapping poses (docs/contacts.md).
+            let parry = match query::contact(&pose_a, ga, &pose_b, gb, f32::MAX) {
+                Ok(Some(c)) => Some(c.dist as f64),
+                _ => None,
+            };
+            match (certified, parry) {
+                (Some(d), Some(p)) => p.min(d),
+                (Some(d), None) => d.min(0.0),
+                (None, Some(p)) => p,
                 // Not reachable for the supported shape pairs; treat as far apart.
-                _ => f64::INFINITY,
+                (None, None) => f64::INFINITY,
             }
         }
     }
@@ -1354,5 +1371,61 @@ mod tests {
         )
         .unwrap();
         assert!(c.landed && (c.time - 8.0 / 9.81).abs() < 1e-5, "{c:?}");
+    }
+
+    /// Overlapping or touching hulls never read as apart: parry's f32 fallback is not
+    /// trusted to raise the certified bound (a review found +8 mm for a 30 um overlap).
+    #[test]
+    fn overlapping_piece_hulls_never_read_as_separated() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/thinker/pieces");
+        let shapes: Vec<ContactShape> = ["pawn", "rook", "queen", "knight"]
+            .iter()
+            .map(|p| {
+                let m = crate::body::load_obj(&dir.join(format!("{p}.obj")), 1.0).unwrap();
+                ContactShape::new(&Shape::Mesh(Arc::new(m)))
+            })
+            .collect();
+        let mut worst = f64::NEG_INFINITY;
+        for (k, (a, b)) in [(0, 0), (1, 2), (2, 3), (3, 0), (1, 1)]
+            .into_iter()
+            .enumerate()
+        {
+            for j in 0..20 {
+                let ang = 0.37 * (k * 20 + j) as f64;
+                let qa = DQuat::from_scaled_axis(DVec3::new(ang.sin(), 0.3 * ang, 0.2));
+                let qb = DQuat::from_scaled_axis(DVec3::new(0.1 * ang, ang.cos(), -0.4));
+                let dir = DVec3::new(ang.cos(), ang.sin(), 0.1).normalize();
+                // Bisect the offset along `dir` at which the hulls start to touch.
+                let (mut lo, mut hi) = (0.0, 0.3);
+                for _ in 0..60 {
+                    let mid = 0.5 * (lo + hi);
+                    // The f64 GJK decides (the function under test must not).
+                    let (pa, pb) = (shapes[a].polytope().unwrap(), shapes[b].polytope().unwrap());
+                    let inv = qa.inverse();
+                    let d = crate::gjk::distance_lower_bound(pa, pb, inv * qb, inv * (dir * mid));
+                    if d > 0.0 {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                for overlap in [30e-6, 1e-6, 0.0] {
+                    let d = signed_distance(
+                        &shapes[a],
+                        DVec3::ZERO,
+                        qa,
+                        &shapes[b],
+                        dir * (lo - overlap),
+                        qb,
+                    );
+                    worst = worst.max(d);
+                    assert!(
+                        d <= CONTACT_DISTANCE,
+                        "pair {a}-{b} pose {j}, overlap {overlap}: {d}"
+                    );
+                }
+            }
+        }
+        assert!(worst > -1e-3, "the poses are near touching ({worst})");
     }
 }
