@@ -187,6 +187,19 @@ pub enum ObjError {
     },
 }
 
+/// The corners of a box centred on the origin with half extents `he`: corner `i` has
+/// `+he.x` when bit 0 of `i` is set (else `-he.x`), bit 1 for y, bit 2 for z. The
+/// rasterizer's box triangles and the contact shapes rely on this order.
+pub fn box_corners(he: DVec3) -> [DVec3; 8] {
+    std::array::from_fn(|i| {
+        DVec3::new(
+            if i & 1 != 0 { he.x } else { -he.x },
+            if i & 2 != 0 { he.y } else { -he.y },
+            if i & 4 != 0 { he.z } else { -he.z },
+        )
+    })
+}
+
 /// Loads every model of an OBJ file into one [`TriMesh`], multiplying coordinates by
 /// `scale` (e.g. 0.001 for a file in millimetres).
 ///

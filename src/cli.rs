@@ -574,6 +574,25 @@ fn solve(
 /// Load `DIR/solution.json` and its scene, and check that they belong together.
 fn load_solution_dir(dir: &Path, scene: Option<&Path>) -> Result<(Problem, Solution)> {
     let file = dir.join("solution.json");
+    let (problem, solution, scene_path) = load_solution_and_scene(dir, &file, scene)?;
+    solver::check_solution(&problem, &solution).with_context(|| {
+        format!(
+            "{} does not belong to the scene {} (pass the right one with --scene)",
+            file.display(),
+            scene_path.display()
+        )
+    })?;
+    Ok((problem, solution))
+}
+
+/// Read the solution `file` (in the output folder `dir`) and load its scene: `scene` if
+/// given, else the scene file it records, else `scenes/<its scene name>`. Does not check
+/// that they belong together (the callers check in their own ways).
+fn load_solution_and_scene(
+    dir: &Path,
+    file: &Path,
+    scene: Option<&Path>,
+) -> Result<(Problem, Solution, PathBuf)> {
     if !file.is_file() {
         bail!(
             "{} has no solution.json: run `bsa solve <scene> --out {}` first",
@@ -581,7 +600,7 @@ fn load_solution_dir(dir: &Path, scene: Option<&Path>) -> Result<(Problem, Solut
             dir.display()
         );
     }
-    let solution = export::read_solution(&file)?;
+    let solution = export::read_solution(file)?;
     let scene_path = match scene {
         Some(p) => p.to_path_buf(),
         None => solution
@@ -592,14 +611,7 @@ fn load_solution_dir(dir: &Path, scene: Option<&Path>) -> Result<(Problem, Solut
             .unwrap_or_else(|| PathBuf::from("scenes").join(&solution.scene)),
     };
     let problem = Problem::new(load_scene(&scene_path)?);
-    solver::check_solution(&problem, &solution).with_context(|| {
-        format!(
-            "{} does not belong to the scene {} (pass the right one with --scene)",
-            file.display(),
-            scene_path.display()
-        )
-    })?;
-    Ok((problem, solution))
+    Ok((problem, solution, scene_path))
 }
 
 /// `<scene>.glb`, `launch.csv` and `trajectory.csv`; returns a one-line summary.
@@ -1022,24 +1034,7 @@ fn budget(
     } else {
         (path.to_path_buf(), path.join("solution.json"))
     };
-    if !file.is_file() {
-        bail!(
-            "{} has no solution.json: run `bsa solve <scene> --out {}` first",
-            dir.display(),
-            dir.display()
-        );
-    }
-    let solution = export::read_solution(&file)?;
-    let scene_path = match scene {
-        Some(p) => p.to_path_buf(),
-        None => solution
-            .scene_file
-            .as_ref()
-            .map(PathBuf::from)
-            .filter(|p| p.exists())
-            .unwrap_or_else(|| PathBuf::from("scenes").join(&solution.scene)),
-    };
-    let problem = Problem::new(load_scene(&scene_path)?);
+    let (problem, solution, scene_path) = load_solution_and_scene(&dir, &file, scene)?;
     budget::check_solution_current(&problem, &solution).with_context(|| {
         format!(
             "{} does not belong to the scene {} (pass the right one with --scene)",

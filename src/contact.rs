@@ -174,15 +174,7 @@ impl ContactShape {
             Shape::Sphere { radius } => ContactShape::Ball(*radius),
             Shape::Cuboid { half_extents } => {
                 let he = *half_extents;
-                let corners: Vec<DVec3> = (0..8)
-                    .map(|i| {
-                        DVec3::new(
-                            if i & 1 != 0 { he.x } else { -he.x },
-                            if i & 2 != 0 { he.y } else { -he.y },
-                            if i & 4 != 0 { he.z } else { -he.z },
-                        )
-                    })
-                    .collect();
+                let corners = crate::body::box_corners(he).to_vec();
                 let edges: Vec<[usize; 2]> = (0..8usize)
                     .flat_map(|i| [1usize, 2, 4].map(move |b| [i, i | b]))
                     .filter(|[i, j]| i != j)
@@ -626,15 +618,7 @@ fn table_signed_distance(
 pub fn table_shape(table: &Table) -> ContactShape {
     // The table's queries never use a cover (see `sphere_clear_of_top`).
     let he = table.half_extents;
-    let corners: Vec<DVec3> = (0..8)
-        .map(|i| {
-            DVec3::new(
-                if i & 1 != 0 { he.x } else { -he.x },
-                if i & 2 != 0 { he.y } else { -he.y },
-                if i & 4 != 0 { he.z } else { -he.z },
-            )
-        })
-        .collect();
+    let corners = crate::body::box_corners(he).to_vec();
     ContactShape::Parry(
         Arc::new(Cuboid::new(he.as_vec3())),
         Arc::new([]),

@@ -481,14 +481,9 @@ impl Problem {
                             inside(p + *radius * DVec3::new(r * a.cos(), r * a.sin(), z), 0.5)
                         })
                     }
-                    Shape::Cuboid { half_extents } => (0..8).all(|k| {
-                        let s = DVec3::new(
-                            if k & 1 != 0 { 1.0 } else { -1.0 },
-                            if k & 2 != 0 { 1.0 } else { -1.0 },
-                            if k & 4 != 0 { 1.0 } else { -1.0 },
-                        );
-                        inside(p + q * (s * *half_extents), 0.0)
-                    }),
+                    Shape::Cuboid { half_extents } => crate::body::box_corners(*half_extents)
+                        .iter()
+                        .all(|c| inside(p + q * *c, 0.0)),
                     Shape::Mesh(m) => m.vertices.iter().all(|v| inside(p + q * *v, 0.0)),
                 }
             })

@@ -389,19 +389,7 @@ mod tests {
     use super::*;
 
     fn box_polytope(he: DVec3) -> Polytope {
-        Polytope::new(box_vertices(he), &[])
-    }
-
-    fn box_vertices(he: DVec3) -> Vec<DVec3> {
-        (0..8)
-            .map(|i| {
-                DVec3::new(
-                    if i & 1 != 0 { he.x } else { -he.x },
-                    if i & 2 != 0 { he.y } else { -he.y },
-                    if i & 4 != 0 { he.z } else { -he.z },
-                )
-            })
-            .collect()
+        Polytope::new(crate::body::box_corners(he).to_vec(), &[])
     }
 
     /// Tiny deterministic generator for the tests.

@@ -601,13 +601,12 @@ impl ShadowCamera {
         let mut verts = [DVec3::ZERO; 8];
         let mut pix = [DVec2::ZERO; 8];
         let mut inside = true;
-        for (i, (p, px)) in verts.iter_mut().zip(&mut pix).enumerate() {
-            let s = DVec3::new(
-                if i & 1 != 0 { 1.0 } else { -1.0 },
-                if i & 2 != 0 { 1.0 } else { -1.0 },
-                if i & 4 != 0 { 1.0 } else { -1.0 },
-            );
-            *p = center + rotation * (s * he);
+        for ((p, px), c) in verts
+            .iter_mut()
+            .zip(&mut pix)
+            .zip(crate::body::box_corners(he))
+        {
+            *p = center + rotation * c;
             let hv = self.homogeneous(*p);
             inside &= self.outcode(hv) == 0;
             *px = DVec2::new(hv.x, hv.y) / hv.z;
