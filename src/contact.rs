@@ -2,24 +2,25 @@
 //!
 //! Main types: [`Motion`] (a body's pose as a function of time: exact free flight or
 //! staying put), [`ContactShape`] (what the distance queries see: an exact ball, or a
-//! parry shape built once per scene) and the functions [`pair_contact_time`] and
-//! [`table_contact_time`].
+//! convex polytope with its sphere cover, built once per scene) and the functions
+//! [`pair_contact_time`] and [`table_contact_time`].
 //!
 //! Contacts are never missed between frames, because time is not sampled in frames:
 //! - Ball against ball is solved in closed form (their centres move on parabolas with the
 //!   same gravity, so the relative motion is linear and the contact time is the first
 //!   root of a quadratic).
-//! - Everything else uses conservative advancement: from the current distance `D` and a
-//!   bound on how fast the two surfaces can approach (relative centre-of-mass speed,
-//!   plus `|w|max * r` for each body, plus the relative gravity over the step), we step
-//!   forward by the largest time in which they cannot touch. Near a contact the steps
-//!   shrink geometrically, so the contact time is found to within `CONTACT_DISTANCE`
-//!   (1 micrometre), whatever the speed. A bounding-sphere test culls far pairs first.
+//! - Everything else uses conservative advancement: from a lower bound `D` of the
+//!   distance and a bound on how fast it can shrink (relative centre-of-mass speed, along
+//!   the separating axis when one is known, plus `|w|max * r` for each body, plus the
+//!   relative gravity over the step), we step forward by the largest time in which they
+//!   cannot touch. Pairs are only searched while their bounding spheres overlap; far apart,
+//!   `D` comes from sphere covers, up close from the f64 GJK of [`crate::gjk`]. The pair
+//!   search stops at [`PAIR_CONTACT_DISTANCE`] (0.1 mm), the table search at
+//!   [`CONTACT_DISTANCE`] (1 micrometre). See `docs/contacts.md`.
 //!
 //! Meshes are tested through their convex hulls (exact for convex pieces, conservative
 //! for concave ones: a contact may be reported up to the hull's overhang early). parry
-//! works in f32, so the relative pose is computed in f64 first and the query runs in
-//! the first body's frame, where coordinates are small.
+//! (f32) only supplies penetration depths, and never raises GJK's certified bound.
 
 use std::sync::Arc;
 
