@@ -73,7 +73,7 @@ pub enum ContactShape {
 /// Spheres (centre in the body frame, radius) whose union contains a convex shape. The
 /// distance between two covers is a lower bound of the distance between the shapes, and
 /// costs a few dozen flops instead of a GJK query: conservative advancement steps on it
-/// while the shapes are more than [`COVER_SWITCH`] apart.
+/// while the shapes are more than `COVER_SWITCH` (1 mm) apart.
 pub type SphereCover = Arc<[(DVec3, f64)]>;
 
 /// Number of slabs (spheres) of a cover.
