@@ -41,11 +41,12 @@ use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::body::{FreeFlight, Shape};
+use crate::body::Shape;
 use crate::drag::{self, BodyDrag, DragConfig, DragError};
 use crate::energy::{self, Weights};
 use crate::evaluate::{launch_velocities, Problem, Workspace, MAX_TURN};
-use crate::solver::{check_solution, MismatchError, Solution};
+use crate::flight::FreeFlight;
+use crate::solution::{check_solution, MismatchError, Solution};
 
 /// The default IoU a shadow must reach to "read" as the picture
 /// ([`BudgetOptions::iou_threshold`]).
@@ -202,8 +203,6 @@ pub enum BudgetError {
     Parameters { expected: usize, found: usize },
     #[error(transparent)]
     Mismatch(#[from] MismatchError),
-    #[error("the solution is for t = {found} s but the scene has t = {expected} s: the scene was edited after the solve")]
-    Time { expected: f64, found: f64 },
     #[error("the scene was edited after the solve: the solution's shadow at t now has IoU {now:.6} and {contacts_now} contacts, the solution recorded IoU {recorded:.6} and {contacts_recorded} (solve again, or pass the scene it was made for)")]
     Stale {
         recorded: f64,
@@ -213,17 +212,11 @@ pub enum BudgetError {
     },
 }
 
-/// Check that a saved solution belongs to this scene as it is now: names and counts
-/// ([`check_solution`]), the same `t`, and the same IoU and contact count at `t` when
+/// Check that a saved solution belongs to this scene as it is now: names, counts and `t`
+/// ([`check_solution`]), and the same IoU and contact count at `t` when
 /// re-evaluated (an edit of the scene that changes the shadow shows up here).
 pub fn check_solution_current(problem: &Problem, s: &Solution) -> Result<(), BudgetError> {
-    check_solution(problem, s)?;
-    if s.t != problem.scene.t {
-        return Err(BudgetError::Time {
-            expected: problem.scene.t,
-            found: s.t,
-        });
-    }
+    check_solution(&problem.scene, s)?;
     let mut ws = problem.workspace();
     let e = problem.evaluate(&s.parameters(), &Weights::all_ones(), &mut ws);
     if (e.iou - s.iou).abs() > 1e-9 || e.outcome.n_contacts != s.n_contacts {
@@ -1743,7 +1736,7 @@ mod tests {
         other.t = 1.5;
         assert!(matches!(
             check_solution_current(&p, &other),
-            Err(BudgetError::Time { .. })
+            Err(BudgetError::Mismatch(MismatchError::Time { .. }))
         ));
         let mut scene = p.scene.clone();
         scene.occluders[0].position += DVec3::new(0.3, 0.0, 0.0);

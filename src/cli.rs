@@ -22,7 +22,8 @@ use crate::energy::{Term, Weights};
 use crate::evaluate::Problem;
 use crate::export;
 use crate::scene::{self, Scene, Stage, Strategy};
-use crate::solver::{self, IterationInfo, Observer, SampleRecord, Solution, SolveOptions};
+use crate::solution::{self, SampleRecord, Solution};
+use crate::solver::{self, IterationInfo, Observer, SolveOptions};
 
 #[derive(Parser)]
 #[command(
@@ -476,16 +477,8 @@ fn solve(
         let file = out.join("solution.json");
         let s = export::read_solution(&file)
             .with_context(|| format!("cannot resume from {}", out.display()))?;
-        solver::check_solution(&problem, &s)
+        solution::check_resumable(scene, &s)
             .with_context(|| format!("cannot resume from {}", file.display()))?;
-        if s.stages_total != scene.stages.len() {
-            bail!(
-                "cannot resume from {}: it has {} stages, the scene has {}",
-                file.display(),
-                s.stages_total,
-                scene.stages.len()
-            );
-        }
         if s.stages_completed >= s.stages_total {
             eprintln!(
                 "{}: all {} stages are done already; nothing to resume",
@@ -575,7 +568,7 @@ fn solve(
 fn load_solution_dir(dir: &Path, scene: Option<&Path>) -> Result<(Problem, Solution)> {
     let file = dir.join("solution.json");
     let (problem, solution, scene_path) = load_solution_and_scene(dir, &file, scene)?;
-    solver::check_solution(&problem, &solution).with_context(|| {
+    solution::check_solution(&problem.scene, &solution).with_context(|| {
         format!(
             "{} does not belong to the scene {} (pass the right one with --scene)",
             file.display(),
@@ -882,7 +875,7 @@ fn eval(
     let scene = load_scene(scene_path)?;
     let problem = Problem::new(scene);
     let s = export::read_solution(solution_path)?;
-    solver::check_solution(&problem, &s)
+    solution::check_solution(&problem.scene, &s)
         .with_context(|| format!("{} does not match the scene", solution_path.display()))?;
     let scene = &problem.scene;
     let k = match stage {

@@ -166,7 +166,7 @@ pub fn simulate(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::body::{FlightConfig, FreeFlight};
+    use crate::flight::{FlightConfig, FreeFlight};
 
     fn scene_with(occluders: &str) -> Scene {
         let dir = std::env::temp_dir().join(format!(

@@ -20,7 +20,7 @@
 //!   (`= 1 / (2 + 1/S)`, Sawicki, Hubbard and Stronge's baseball fit, which has the right
 //!   limits: `C_L ~ S` for slow spin, 1/2 for fast spin). It needs no division by `|v|`.
 //! * No drag torque: the rotation stays the exact torque-free one of
-//!   [`crate::body::FreeFlight`] (a sphere keeps its spin, so the Magnus axis is fixed).
+//!   [`crate::flight::FreeFlight`] (a sphere keeps its spin, so the Magnus axis is fixed).
 //!
 //! The integrator is classical RK4 on a uniform grid of at most
 //! [`DragConfig::max_step`] seconds. Measured against the closed forms of vertical

@@ -23,9 +23,11 @@
 
 use glam::{DQuat, DVec3};
 
-use crate::body::{FlightConfig, FreeFlight, Shape};
-use crate::contact::{self, Body, ContactShape, Motion};
+use crate::body::Shape;
+use crate::contact::{self, Body, Motion};
+use crate::distance::{table_shape, ContactShape};
 use crate::energy::{self, TargetData, Term, Weights, DIVERGED_ENERGY, REG_ALPHA, TERM_COUNT};
+use crate::flight::{FlightConfig, FreeFlight};
 use crate::mask::Mask;
 use crate::raster::{MeshSilhouette, RasterScratch};
 use crate::scene::Scene;
@@ -142,7 +144,7 @@ impl Problem {
                 _ => true,
             })
             .collect();
-        let table_shape = scene.table.as_ref().map(contact::table_shape);
+        let table_shape = scene.table.as_ref().map(table_shape);
         let silhouettes = scene
             .occluders
             .iter()

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use crate::energy::{Term, TERM_COUNT};
 use crate::mask::Mask;
 use crate::picture;
-use crate::solver::{SampleRecord, Solution};
+use crate::solution::{SampleRecord, Solution};
 
 /// Why an output could not be written or read.
 #[derive(Debug, thiserror::Error)]

@@ -18,7 +18,7 @@
 //! the animation, and the importer's inverse change of axes gives the Z-up world back.
 
 use std::borrow::Cow;
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::{BTreeMap, HashMap};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use glam::{DMat3, DQuat, DVec3};
@@ -36,9 +36,6 @@ pub const ANIMATION_NAME: &str = "flight";
 /// Luminous intensity of the point light (cd). Only its presence and position matter for
 /// hard shadows; 1000 cd lights a receiver a few metres away well in a PBR viewer.
 pub const LIGHT_INTENSITY_CD: f64 = 1000.0;
-/// Node names the writer uses for non-occluders; occluders may not take them.
-pub const RESERVED_NAMES: [&str; 5] =
-    ["receiver", "table", "light", "camera_shadow", "camera_view"];
 
 /// UV sphere resolution: segments around the polar axis and rings from pole to pole.
 /// 128 x 64 keeps the inscribed polyhedron's shadow within about a pixel of the exact
@@ -103,12 +100,6 @@ pub enum GltfError {
     /// `write_glb`: a pose, the light or the receiver holds a NaN or infinity.
     #[error("{0} is not finite")]
     NonFinite(String),
-    /// `write_glb`: an occluder's name is one the writer uses for another node.
-    #[error("occluder name `{0}` is reserved for another node of the glTF scene")]
-    ReservedName(String),
-    /// `write_glb`: two occluders share a name (node names must identify occluders).
-    #[error("occluder name `{0}` is used twice")]
-    DuplicateName(String),
     /// `write_glb`: an occluder mesh has no triangle of non-zero area.
     #[error("occluder `{0}` has a mesh without any non-degenerate triangle")]
     EmptyMesh(String),
@@ -429,15 +420,6 @@ fn check_input(scene: &Scene, traj: &Trajectory) -> Result<(), GltfError> {
     ] {
         if !v.is_finite() {
             return Err(GltfError::NonFinite(what.into()));
-        }
-    }
-    let mut seen = HashSet::new();
-    for occ in &scene.occluders {
-        if RESERVED_NAMES.contains(&occ.name.as_str()) {
-            return Err(GltfError::ReservedName(occ.name.clone()));
-        }
-        if !seen.insert(occ.name.as_str()) {
-            return Err(GltfError::DuplicateName(occ.name.clone()));
         }
     }
     Ok(())
@@ -1089,6 +1071,8 @@ fn trimesh_mesh(mesh: &TriMesh) -> MeshData {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::RESERVED_NAMES;
+    use std::collections::HashSet;
     use std::path::PathBuf;
     use std::sync::Arc;
 
@@ -1535,12 +1519,6 @@ mod tests {
         let mut t = good.clone();
         t.fps = 0.0;
         assert!(matches!(write_glb(&scene, &t), Err(GltfError::BadFps(_))));
-        let mut s = scene.clone();
-        s.occluders[1].name = "light".into();
-        assert!(matches!(
-            write_glb(&s, &good),
-            Err(GltfError::ReservedName(_))
-        ));
         assert!(matches!(
             read_poses_at(b"not a glb", 0.0),
             Err(GltfError::Parse(_))

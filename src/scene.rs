@@ -18,7 +18,9 @@ use std::sync::Arc;
 use glam::{DQuat, DVec2, DVec3};
 use serde::Deserialize;
 
+pub use crate::body::Table;
 use crate::body::{self, MassProperties, Shape, TriMesh};
+use crate::distance::{signed_distance, table_shape, table_signed_distance, ContactShape};
 use crate::energy::{Term, Weights, TERM_COUNT};
 use crate::mask::Mask;
 use crate::raster::ShadowCamera;
@@ -225,21 +227,6 @@ pub struct Receiver {
     pub height: f64,
 }
 
-/// The table (or ground) the occluders are launched from: an axis-aligned box whose
-/// top face is the surface. Launched bodies that come back down onto it stop there.
-#[derive(Clone, Debug)]
-pub struct Table {
-    pub center: DVec3,
-    pub half_extents: DVec3,
-}
-
-impl Table {
-    /// Height of the table's top face (m).
-    pub fn top(&self) -> f64 {
-        self.center.z + self.half_extents.z
-    }
-}
-
 /// One occluder, resolved: shape, mass properties and launch pose.
 #[derive(Clone, Debug)]
 pub struct Occluder {
@@ -357,6 +344,11 @@ impl Scene {
         self.occluders.iter().position(|o| o.name == name)
     }
 }
+
+/// Node names the glTF export uses for what is not an occluder; occluders may not take
+/// them (checked here, so that the export cannot fail on a loaded scene).
+pub const RESERVED_NAMES: [&str; 5] =
+    ["receiver", "table", "light", "camera_shadow", "camera_view"];
 
 /// Largest target image side (pixels).
 pub const MAX_IMAGE_SIDE: usize = 16384;
@@ -520,6 +512,16 @@ impl Validator<'_> {
         }
         for (i, ro) in raw.occluders.iter().enumerate() {
             let o = self.occluder(i, ro, t, gravity, rise)?;
+            if RESERVED_NAMES.contains(&o.name.as_str()) {
+                return Err(self.field_err(
+                    format!("occluders[{i}].name"),
+                    format!(
+                        "`{}` is the name of a node of the glTF export; occluders may not use {}",
+                        o.name,
+                        RESERVED_NAMES.map(|n| format!("`{n}`")).join(", ")
+                    ),
+                ));
+            }
             if occluders.iter().any(|p: &Occluder| p.name == o.name) {
                 return Err(self.field_err(
                     format!("occluders[{i}].name"),
@@ -760,7 +762,16 @@ impl Validator<'_> {
         const TOL: f64 = 1e-4;
         for i in 0..occ.len() {
             for j in (i + 1)..occ.len() {
-                let d = crate::contact::signed_distance_at_launch(&occ[i], &occ[j]);
+                let (a, b) = (&occ[i], &occ[j]);
+                let (sa, sb) = (ContactShape::new(&a.shape), ContactShape::new(&b.shape));
+                let d = signed_distance(
+                    &sa,
+                    a.position,
+                    a.orientation,
+                    &sb,
+                    b.position,
+                    b.orientation,
+                );
                 if d < -TOL {
                     return Err(SceneError::Overlap {
                         path: self.file.to_path_buf(),
@@ -770,7 +781,9 @@ impl Validator<'_> {
                 }
             }
             if let Some(tb) = table {
-                let d = crate::contact::table_signed_distance_at_launch(&occ[i], tb);
+                let o = &occ[i];
+                let s = ContactShape::new(&o.shape);
+                let d = table_signed_distance(&s, o.position, o.orientation, tb, &table_shape(tb));
                 if d < -TOL {
                     return Err(SceneError::Overlap {
                         path: self.file.to_path_buf(),

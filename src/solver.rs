@@ -25,13 +25,13 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
 use crate::cmaes::{Cmaes, CmaesConfig, StopReason};
 use crate::energy::{Term, Weights, TERM_COUNT};
 use crate::evaluate::{launch_velocities, Evaluation, Problem, Workspace};
 use crate::mask::Mask;
 use crate::scene::Stage;
+use crate::solution::{Launch, SampleRecord, Solution, StageReport, TermValue};
 
 /// How to run a solve.
 #[derive(Clone, Debug, Default)]
@@ -73,142 +73,6 @@ pub trait Observer {
 /// An observer that ignores everything (tests, benchmarks).
 pub struct Silent;
 impl Observer for Silent {}
-
-/// One evaluated sample: a row of `convergence.csv`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SampleRecord {
-    pub stage: usize,
-    pub iteration: usize,
-    /// Weighted value of each term, in [`Term::ALL`] order.
-    pub terms: [f64; TERM_COUNT],
-    pub total: f64,
-}
-
-/// Launch of one occluder.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Launch {
-    pub name: String,
-    pub launched: bool,
-    /// Centre-of-mass launch velocity (m/s, world).
-    pub velocity: [f64; 3],
-    /// Launch angular velocity (rad/s, world).
-    pub angular_velocity: [f64; 3],
-}
-
-/// Value of one energy term.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct TermValue {
-    pub raw: f64,
-    pub weighted: f64,
-}
-
-/// Summary of one stage.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct StageReport {
-    pub name: String,
-    pub iterations: usize,
-    pub samples: usize,
-    pub population: usize,
-    pub best_energy: f64,
-    pub iou: f64,
-    pub stop: String,
-    pub wall_time_s: f64,
-}
-
-/// Everything `solution.json` holds.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Solution {
-    pub scene: String,
-    /// The scene file the solution was made from (absolute when known); `export`,
-    /// `validate` and `video` find the scene through it unless told otherwise.
-    #[serde(default)]
-    pub scene_file: Option<String>,
-    pub seed: u64,
-    pub t: f64,
-    pub stages_total: usize,
-    pub stages_completed: usize,
-    /// True when the solve ran every stage to its own stop (not cut short by Ctrl-C).
-    pub complete: bool,
-    pub occluders: Vec<Launch>,
-    /// Every term at the solution, raw and weighted with the last completed stage's weights.
-    pub energy: std::collections::BTreeMap<String, TermValue>,
-    pub total_energy: f64,
-    pub iou: f64,
-    pub t_sim: f64,
-    pub n_contacts: u32,
-    pub samples: usize,
-    pub iterations: usize,
-    pub wall_time_s: f64,
-    pub threads: usize,
-    /// Mean time per phase of one sample on one core (microseconds).
-    pub time_per_term_us: std::collections::BTreeMap<String, f64>,
-    pub stages: Vec<StageReport>,
-}
-
-impl Solution {
-    /// The launch values as the solver's parameter vector (6 per occluder).
-    pub fn parameters(&self) -> Vec<f64> {
-        self.occluders
-            .iter()
-            .flat_map(|o| o.velocity.iter().chain(o.angular_velocity.iter()).copied())
-            .collect()
-    }
-}
-
-/// Why a solution does not belong to a scene.
-#[derive(Debug, thiserror::Error)]
-pub enum MismatchError {
-    #[error("the solution is for scene `{found}`, not `{expected}`")]
-    Scene { expected: String, found: String },
-    #[error("the solution has {found} occluders, the scene has {expected}")]
-    Count { expected: usize, found: usize },
-    #[error("occluder {index} is `{found}` in the solution but `{expected}` in the scene")]
-    Name {
-        index: usize,
-        expected: String,
-        found: String,
-    },
-    #[error("the solution has {found} stages, the scene has {expected}")]
-    Stages { expected: usize, found: usize },
-    #[error("the solution holds a non-finite launch value for `{name}`")]
-    NotFinite { name: String },
-}
-
-/// Check that a solution was made for this scene (names and counts match).
-pub fn check_solution(problem: &Problem, s: &Solution) -> Result<(), MismatchError> {
-    let scene = &problem.scene;
-    if s.scene != scene.name {
-        return Err(MismatchError::Scene {
-            expected: scene.name.clone(),
-            found: s.scene.clone(),
-        });
-    }
-    if s.occluders.len() != scene.occluders.len() {
-        return Err(MismatchError::Count {
-            expected: scene.occluders.len(),
-            found: s.occluders.len(),
-        });
-    }
-    for (i, (a, b)) in scene.occluders.iter().zip(&s.occluders).enumerate() {
-        if a.name != b.name {
-            return Err(MismatchError::Name {
-                index: i,
-                expected: a.name.clone(),
-                found: b.name.clone(),
-            });
-        }
-        if b.velocity
-            .iter()
-            .chain(&b.angular_velocity)
-            .any(|x| !x.is_finite())
-        {
-            return Err(MismatchError::NotFinite {
-                name: b.name.clone(),
-            });
-        }
-    }
-    Ok(())
-}
 
 /// Per-thread workspaces, indexed by rayon's thread index. Each is only ever locked by
 /// its own thread, so the locks are uncontended; they exist to satisfy the borrow rules.

@@ -7,7 +7,8 @@ use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use bsa::evaluate::Problem;
-use bsa::solver::{self, Observer, SampleRecord, Solution, SolveOptions};
+use bsa::solution::{SampleRecord, Solution};
+use bsa::solver::{self, Observer, SolveOptions};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -93,6 +94,11 @@ fn bad_input_gets_clear_errors() {
     // Unknown field.
     let d = variant("unknown", |v| v["colour"] = "red".into());
     assert_rejected(&d, &["scene.json", "unknown field `colour`"]);
+
+    // An occluder named after a node of the glTF export: refused when the scene is
+    // loaded, not after the solve when the export runs.
+    let d = variant("reserved", |v| v["occluders"][1]["name"] = "table".into());
+    assert_rejected(&d, &["scene.json", "occluders[1].name", "`table`"]);
 
     // Target that is not a PNG.
     let d = variant("notpng", |_| {});

@@ -1,0 +1,171 @@
+//! The result files' schema: what `solution.json` and `convergence.csv` hold, and the
+//! check that a saved solution belongs to a scene.
+//!
+//! Main types: [`Solution`] (the whole `solution.json`: per occluder a [`Launch`], every
+//! term as a [`TermValue`], one [`StageReport`] per stage), [`SampleRecord`] (one row of
+//! `convergence.csv`) and [`MismatchError`]. The solver produces these values; `export`
+//! writes and reads them; `eval`, `export`, `validate`, `video`, `budget` and `--resume`
+//! check a loaded one with [`check_solution`] (or [`check_resumable`]) before using it.
+
+use serde::{Deserialize, Serialize};
+
+use crate::energy::TERM_COUNT;
+use crate::scene::Scene;
+
+/// One evaluated sample: a row of `convergence.csv`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SampleRecord {
+    pub stage: usize,
+    pub iteration: usize,
+    /// Weighted value of each term, in [`crate::energy::Term::ALL`] order.
+    pub terms: [f64; TERM_COUNT],
+    pub total: f64,
+}
+
+/// Launch of one occluder.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Launch {
+    pub name: String,
+    pub launched: bool,
+    /// Centre-of-mass launch velocity (m/s, world).
+    pub velocity: [f64; 3],
+    /// Launch angular velocity (rad/s, world).
+    pub angular_velocity: [f64; 3],
+}
+
+/// Value of one energy term.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TermValue {
+    pub raw: f64,
+    pub weighted: f64,
+}
+
+/// Summary of one stage.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StageReport {
+    pub name: String,
+    pub iterations: usize,
+    pub samples: usize,
+    pub population: usize,
+    pub best_energy: f64,
+    pub iou: f64,
+    pub stop: String,
+    pub wall_time_s: f64,
+}
+
+/// Everything `solution.json` holds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Solution {
+    pub scene: String,
+    /// The scene file the solution was made from (absolute when known); `export`,
+    /// `validate` and `video` find the scene through it unless told otherwise.
+    #[serde(default)]
+    pub scene_file: Option<String>,
+    pub seed: u64,
+    pub t: f64,
+    pub stages_total: usize,
+    pub stages_completed: usize,
+    /// True when the solve ran every stage to its own stop (not cut short by Ctrl-C).
+    pub complete: bool,
+    pub occluders: Vec<Launch>,
+    /// Every term at the solution, raw and weighted with the last completed stage's weights.
+    pub energy: std::collections::BTreeMap<String, TermValue>,
+    pub total_energy: f64,
+    pub iou: f64,
+    pub t_sim: f64,
+    pub n_contacts: u32,
+    pub samples: usize,
+    pub iterations: usize,
+    pub wall_time_s: f64,
+    pub threads: usize,
+    /// Mean time per phase of one sample on one core (microseconds).
+    pub time_per_term_us: std::collections::BTreeMap<String, f64>,
+    pub stages: Vec<StageReport>,
+}
+
+impl Solution {
+    /// The launch values as the solver's parameter vector (6 per occluder).
+    pub fn parameters(&self) -> Vec<f64> {
+        self.occluders
+            .iter()
+            .flat_map(|o| o.velocity.iter().chain(o.angular_velocity.iter()).copied())
+            .collect()
+    }
+}
+
+/// Why a solution does not belong to a scene.
+#[derive(Debug, thiserror::Error)]
+pub enum MismatchError {
+    #[error("the solution is for scene `{found}`, not `{expected}`")]
+    Scene { expected: String, found: String },
+    #[error("the solution has {found} occluders, the scene has {expected}")]
+    Count { expected: usize, found: usize },
+    #[error("occluder {index} is `{found}` in the solution but `{expected}` in the scene")]
+    Name {
+        index: usize,
+        expected: String,
+        found: String,
+    },
+    #[error("it has {found} stages, the scene has {expected}")]
+    Stages { expected: usize, found: usize },
+    #[error("the solution is for t = {found} s but the scene has t = {expected} s: the scene was edited after the solve")]
+    Time { expected: f64, found: f64 },
+    #[error("the solution holds a non-finite launch value for `{name}`")]
+    NotFinite { name: String },
+}
+
+/// Check that a solution was made for this scene: the scene's name, the occluders'
+/// count and names, the instant `t`, and finite launch values. Every command that reads
+/// a solution checks it here.
+pub fn check_solution(scene: &Scene, s: &Solution) -> Result<(), MismatchError> {
+    if s.scene != scene.name {
+        return Err(MismatchError::Scene {
+            expected: scene.name.clone(),
+            found: s.scene.clone(),
+        });
+    }
+    if s.occluders.len() != scene.occluders.len() {
+        return Err(MismatchError::Count {
+            expected: scene.occluders.len(),
+            found: s.occluders.len(),
+        });
+    }
+    for (i, (a, b)) in scene.occluders.iter().zip(&s.occluders).enumerate() {
+        if a.name != b.name {
+            return Err(MismatchError::Name {
+                index: i,
+                expected: a.name.clone(),
+                found: b.name.clone(),
+            });
+        }
+        if b.velocity
+            .iter()
+            .chain(&b.angular_velocity)
+            .any(|x| !x.is_finite())
+        {
+            return Err(MismatchError::NotFinite {
+                name: b.name.clone(),
+            });
+        }
+    }
+    if s.t != scene.t {
+        return Err(MismatchError::Time {
+            expected: scene.t,
+            found: s.t,
+        });
+    }
+    Ok(())
+}
+
+/// [`check_solution`], and that the solution's stages are the scene's, so that a solve
+/// can resume after its completed stages.
+pub fn check_resumable(scene: &Scene, s: &Solution) -> Result<(), MismatchError> {
+    check_solution(scene, s)?;
+    if s.stages_total != scene.stages.len() {
+        return Err(MismatchError::Stages {
+            expected: scene.stages.len(),
+            found: s.stages_total,
+        });
+    }
+    Ok(())
+}
