@@ -25,7 +25,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 
 use bsa::energy::Weights;
 use bsa::evaluate::Problem;
-use bsa::solver::{self, SolveOptions};
+use bsa::optimize::solver::{self, SolveOptions};
 
 fn mickey() -> Problem {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/mickey");
@@ -79,8 +79,9 @@ fn benches(c: &mut Criterion) {
         })
     });
     group.bench_function("budget_mickey_10k_2_threads", |b| {
-        let budget = bsa::budget::Budget::new(&p, &NEAR_SOLUTION, bsa::drag::DragConfig::default())
-            .expect("valid drag config");
+        let budget =
+            bsa::budget::Budget::new(&p, &NEAR_SOLUTION, bsa::sim::drag::DragConfig::default())
+                .expect("valid drag config");
         let (comp, _) = budget.compensate();
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(2)

@@ -22,7 +22,7 @@
 //!   each piece is one closed, consistently oriented shell (a union by construction).
 //!
 //! Each mesh is checked (closed and oriented, no degenerate triangle, no intersecting
-//! triangles), written, reloaded with `bsa::body::load_obj` and checked again.
+//! triangles), written, reloaded with `bsa::geometry::shape::load_obj` and checked again.
 
 use std::collections::HashMap;
 use std::error::Error;
@@ -30,7 +30,7 @@ use std::f64::consts::TAU;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use bsa::body::{load_obj, Shape, TriMesh};
+use bsa::geometry::shape::{load_obj, Shape, TriMesh};
 use glam::{DVec2, DVec3};
 
 /// Columns around the axis of a surface of revolution.

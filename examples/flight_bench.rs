@@ -1,6 +1,6 @@
 //! Accuracy and cost of `FreeFlight` (run with `cargo run --release --example flight_bench`).
-use bsa::body::{MassProperties, Shape};
-use bsa::flight::{FlightConfig, FreeFlight};
+use bsa::geometry::shape::{MassProperties, Shape};
+use bsa::sim::flight::{FlightConfig, FreeFlight};
 use glam::{DQuat, DVec3};
 use std::hint::black_box;
 use std::time::Instant;

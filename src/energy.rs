@@ -16,7 +16,7 @@
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
-use crate::mask::{Mask, Moments};
+use crate::shadow::mask::{Mask, Moments};
 
 /// Number of energy terms.
 pub const TERM_COUNT: usize = 10;

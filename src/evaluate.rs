@@ -8,11 +8,11 @@
 //! Data flow of [`Problem::evaluate`]:
 //! 1. exact free flight of every launched body from its launch pose ([`FreeFlight`]);
 //! 2. first contact between bodies, or of a launched body with the table, before `t`
-//!    ([`crate::contact`]) gives `t_sim` and `n_contact`;
+//!    ([`crate::sim::contact`]) gives `t_sim` and `n_contact`;
 //! 3. poses at `t`: the bodies carry on by free flight after the stop (the contact only
 //!    costs its penalty), and a body that lands stays on the table (its vertical motion
 //!    is absorbed, its horizontal motion and spin go on), so it is never lost under it;
-//! 4. the exact shadow at `t` into a bit mask ([`crate::raster`]);
+//! 4. the exact shadow at `t` into a bit mask ([`crate::shadow::raster`]);
 //! 5. the energy terms ([`crate::energy`]).
 //!
 //! Taking the shadow at `t` rather than at the stop matters: the field notes record that
@@ -23,14 +23,14 @@
 
 use glam::{DQuat, DVec3};
 
-use crate::body::Shape;
-use crate::contact::{self, Body, Motion};
-use crate::distance::{table_shape, ContactShape};
 use crate::energy::{self, TargetData, Term, Weights, DIVERGED_ENERGY, REG_ALPHA, TERM_COUNT};
-use crate::flight::{FlightConfig, FreeFlight};
-use crate::mask::Mask;
-use crate::raster::{MeshSilhouette, RasterScratch};
+use crate::geometry::distance::{table_shape, ContactShape};
+use crate::geometry::shape::Shape;
 use crate::scene::Scene;
+use crate::shadow::mask::Mask;
+use crate::shadow::raster::{MeshSilhouette, RasterScratch};
+use crate::sim::contact::{self, Body, Motion};
+use crate::sim::flight::{FlightConfig, FreeFlight};
 
 /// Largest total rotation (rad) of a launched body by `t` that a sample may ask for; more
 /// (over 300 turns) is treated as a diverged sample.
@@ -483,9 +483,11 @@ impl Problem {
                             inside(p + *radius * DVec3::new(r * a.cos(), r * a.sin(), z), 0.5)
                         })
                     }
-                    Shape::Cuboid { half_extents } => crate::body::box_corners(*half_extents)
-                        .iter()
-                        .all(|c| inside(p + q * *c, 0.0)),
+                    Shape::Cuboid { half_extents } => {
+                        crate::geometry::shape::box_corners(*half_extents)
+                            .iter()
+                            .all(|c| inside(p + q * *c, 0.0))
+                    }
                     Shape::Mesh(m) => m.vertices.iter().all(|v| inside(p + q * *v, 0.0)),
                 }
             })

@@ -2,30 +2,22 @@
 //! instant of their flight, the shadows they cast from a point light onto a plane form
 //! a target picture.
 //!
-//! Pipeline (see `docs/ARCHITECTURE.md`): [`scene`] (validated input) -> [`body`]
-//! (exact free flight) and [`contact`] (first contact) -> [`raster`] (exact shadow into
-//! a [`mask::Mask`]) -> [`energy`] (the paper's ten terms) -> [`evaluate`] (one sample)
-//! -> [`solver`] with [`cmaes`] (stages of CMA-ES) -> [`export`] (files).
+//! Pipeline (see `docs/ARCHITECTURE.md`), one folder per stage, each importing only
+//! from the ones before it: [`scene`] (validated input, on [`geometry`]'s shapes) ->
+//! [`sim`] (exact free flight, first contacts, rapier after `t`, air drag) ->
+//! [`shadow`] (exact shadow into a [`shadow::mask::Mask`]) -> [`energy`] (the paper's
+//! ten terms) -> [`evaluate`] (one sample) -> [`optimize`] (stages of CMA-ES) ->
+//! [`output`] (the result schema and files) and [`budget`] (the error budget); [`cli`]
+//! is the glue of the `bsa` binary.
 
-pub mod body;
 pub mod budget;
 pub mod cli;
-pub mod cmaes;
-pub mod contact;
-pub mod continuation;
-pub mod distance;
-pub mod drag;
 pub mod energy;
 pub mod evaluate;
-pub mod export;
-pub mod flight;
-pub mod gjk;
-pub mod gltf_export;
+pub mod geometry;
 pub mod linalg;
-pub mod mask;
-pub mod picture;
-pub mod raster;
+pub mod optimize;
+pub mod output;
 pub mod scene;
-pub mod solution;
-pub mod solver;
-pub mod trajectory;
+pub mod shadow;
+pub mod sim;

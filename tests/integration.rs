@@ -7,8 +7,8 @@ use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use bsa::evaluate::Problem;
-use bsa::solution::{SampleRecord, Solution};
-use bsa::solver::{self, Observer, SolveOptions};
+use bsa::optimize::solver::{self, Observer, SolveOptions};
+use bsa::output::solution::{SampleRecord, Solution};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -373,8 +373,9 @@ fn golden_shadow_of_a_fixed_launch() {
     let mut ws = p.workspace();
     p.evaluate(&params, &bsa::energy::Weights::all_ones(), &mut ws);
     let golden = root().join("tests/golden/mickey_fixed_launch.png");
-    let now =
-        bsa::picture::mask_image(ws.mask.width(), ws.mask.height(), &|x, y| ws.mask.get(x, y));
+    let now = bsa::output::picture::mask_image(ws.mask.width(), ws.mask.height(), &|x, y| {
+        ws.mask.get(x, y)
+    });
     if std::env::var_os("BSA_UPDATE_GOLDEN").is_some() {
         std::fs::create_dir_all(golden.parent().unwrap()).unwrap();
         now.save(&golden).unwrap();
@@ -390,7 +391,7 @@ fn golden_shadow_of_a_fixed_launch() {
         .filter(|(a, b)| a != b)
         .count();
     if differing > 0 {
-        let diff = bsa::picture::difference_image(
+        let diff = bsa::output::picture::difference_image(
             old.width() as usize,
             old.height() as usize,
             &|x, y| old.get_pixel(x as u32, y as u32).0[0] < 128,
@@ -640,11 +641,11 @@ fn quick_solve(scene: &Path, name: &str) -> PathBuf {
 fn exported_glb_gives_the_solvers_poses_at_t() {
     let out = quick_solve(&root().join("scenes/mickey"), "glb-poses");
     let p = Problem::new(bsa::scene::load(&root().join("scenes/mickey")).unwrap());
-    let sol = bsa::export::read_solution(&out.join("solution.json")).unwrap();
+    let sol = bsa::output::files::read_solution(&out.join("solution.json")).unwrap();
     let mut ws = p.workspace();
     p.fly(&sol.parameters(), &mut ws);
     let glb = std::fs::read(out.join("mickey.glb")).unwrap();
-    let read = bsa::gltf_export::read_poses_at(&glb, p.scene.t).unwrap();
+    let read = bsa::output::gltf::read_poses_at(&glb, p.scene.t).unwrap();
     for (i, o) in p.scene.occluders.iter().enumerate() {
         let (name, pos, q) = read
             .iter()
@@ -769,7 +770,7 @@ fn blender_imports_animation_light_cameras_and_frame_range() {
     assert!((light[2].as_f64().unwrap() - 6.0).abs() < 1e-5, "{light}");
     // The animation plays: each occluder is where the solver put it at t.
     let p = Problem::new(bsa::scene::load(&root().join("scenes/mickey")).unwrap());
-    let sol = bsa::export::read_solution(&out.join("solution.json")).unwrap();
+    let sol = bsa::output::files::read_solution(&out.join("solution.json")).unwrap();
     let mut ws = p.workspace();
     p.fly(&sol.parameters(), &mut ws);
     for (i, o) in p.scene.occluders.iter().enumerate() {

@@ -1,6 +1,6 @@
 //! Exact torque-free free flight of one rigid body.
 //!
-//! [`FreeFlight::reset`] takes the mass properties of [`crate::body`] and a launch state
+//! [`FreeFlight::reset`] takes the mass properties of [`crate::geometry::shape`] and a launch state
 //! (pose, linear and angular velocity, gravity) and prepares an exact torque-free flight;
 //! the pose at any time is then a cheap query ([`FreeFlight::pose`],
 //! [`FreeFlight::orientation`], [`FreeFlight::com`], ...).
@@ -20,7 +20,7 @@
 
 use glam::{DQuat, DVec3};
 
-use crate::body::MassProperties;
+use crate::geometry::shape::MassProperties;
 
 /// Relative tolerance under which two principal moments count as equal, so that the
 /// closed-form isotropic or axisymmetric rotation is used. At 1e-9 the closed form's
@@ -434,8 +434,8 @@ impl FreeFlight {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::body::tests::*;
-    use crate::body::Shape;
+    use crate::geometry::shape::tests::*;
+    use crate::geometry::shape::Shape;
     use glam::DMat3;
     use std::sync::Arc;
 

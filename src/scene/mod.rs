@@ -18,12 +18,14 @@ use std::sync::Arc;
 use glam::{DQuat, DVec2, DVec3};
 use serde::Deserialize;
 
-pub use crate::body::Table;
-use crate::body::{self, MassProperties, Shape, TriMesh};
-use crate::distance::{signed_distance, table_shape, table_signed_distance, ContactShape};
 use crate::energy::{Term, Weights, TERM_COUNT};
-use crate::mask::Mask;
-use crate::raster::ShadowCamera;
+use crate::geometry::distance::{
+    signed_distance, table_shape, table_signed_distance, ContactShape,
+};
+pub use crate::geometry::shape::Table;
+use crate::geometry::shape::{self, MassProperties, Shape, TriMesh};
+use crate::shadow::mask::Mask;
+use crate::shadow::raster::ShadowCamera;
 
 /// Why a scene could not be loaded. Every variant names the file, and the field when
 /// one is at fault, so that the message alone tells the user what to fix.
@@ -58,7 +60,7 @@ pub enum SceneError {
         path: PathBuf,
         field: String,
         #[source]
-        source: body::ObjError,
+        source: shape::ObjError,
     },
     /// A line of a hints text file is malformed.
     #[error("{path}:{line}: {reason}")]
@@ -683,7 +685,7 @@ impl Validator<'_> {
                 let scale = self.positive(&f("shape.mesh.scale"), scale.unwrap_or(1.0))?;
                 let path = self.resolve(obj);
                 let mesh: TriMesh =
-                    body::load_obj(&path, scale).map_err(|source| SceneError::Obj {
+                    shape::load_obj(&path, scale).map_err(|source| SceneError::Obj {
                         path: path.clone(),
                         field: f("shape.mesh.obj"),
                         source,

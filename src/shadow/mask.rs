@@ -7,7 +7,7 @@
 //! may hold set bits; rows outside it are guaranteed zero, which lets [`Mask::clear`] and
 //! the counting functions skip the empty part of a sparse shadow image.
 //!
-//! Data flow in the project: the rasterizer ([`crate::raster`]) fills a cleared mask with
+//! Data flow in the project: the rasterizer ([`crate::shadow::raster`]) fills a cleared mask with
 //! [`Mask::fill_span`]; the energies then compare it with the target through
 //! [`Mask::xor_count`], [`Mask::and_count`], [`Mask::and_not_count`] and
 //! [`Mask::moments`] (which returns [`Moments`]). The morphological operations

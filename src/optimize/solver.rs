@@ -26,12 +26,12 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use crate::cmaes::{Cmaes, CmaesConfig, StopReason};
 use crate::energy::{Term, Weights, TERM_COUNT};
 use crate::evaluate::{launch_velocities, Evaluation, Problem, Workspace};
-use crate::mask::Mask;
+use crate::optimize::cmaes::{Cmaes, CmaesConfig, StopReason};
+use crate::output::solution::{Launch, SampleRecord, Solution, StageReport, TermValue};
 use crate::scene::Stage;
-use crate::solution::{Launch, SampleRecord, Solution, StageReport, TermValue};
+use crate::shadow::mask::Mask;
 
 /// How to run a solve.
 #[derive(Clone, Debug, Default)]

@@ -10,9 +10,9 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::energy::{Term, TERM_COUNT};
-use crate::mask::Mask;
-use crate::picture;
-use crate::solution::{SampleRecord, Solution};
+use crate::output::picture;
+use crate::output::solution::{SampleRecord, Solution};
+use crate::shadow::mask::Mask;
 
 /// Why an output could not be written or read.
 #[derive(Debug, thiserror::Error)]

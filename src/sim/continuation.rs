@@ -15,7 +15,7 @@
 //!   `v - g h / 2`, which makes its trajectory the exact one (up to f32 rounding), and
 //!   add `g h / 2` back when reading velocities.
 //! - rapier's own principal-axis computation is wrong for tiny inertia tensors, so mass
-//!   properties are passed explicitly (principal inertia and frame from [`crate::body`])
+//!   properties are passed explicitly (principal inertia and frame from [`crate::geometry::shape`])
 //!   and colliders get zero density.
 
 use glam::{DQuat, DVec3};
@@ -24,7 +24,7 @@ use rapier3d::prelude::{
     ColliderBuilder, MassProperties, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle, SharedShape,
 };
 
-use crate::body::Shape;
+use crate::geometry::shape::Shape;
 use crate::scene::Scene;
 
 /// Tunables of the continuation.
@@ -166,7 +166,7 @@ pub fn simulate(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flight::{FlightConfig, FreeFlight};
+    use crate::sim::flight::{FlightConfig, FreeFlight};
 
     fn scene_with(occluders: &str) -> Scene {
         let dir = std::env::temp_dir().join(format!(

@@ -14,7 +14,7 @@
 //!   the separating axis when one is known, plus `|w|max * r` for each body, plus the
 //!   relative gravity over the step), we step forward by the largest time in which they
 //!   cannot touch. Pairs are only searched while their bounding spheres overlap; far apart,
-//!   `D` comes from sphere covers, up close from the f64 GJK of [`crate::gjk`]. The pair
+//!   `D` comes from sphere covers, up close from the f64 GJK of [`crate::geometry::gjk`]. The pair
 //!   search stops at [`PAIR_CONTACT_DISTANCE`] (0.1 mm), the table search at
 //!   [`CONTACT_DISTANCE`] (1 micrometre). See `docs/contacts.md`.
 //!
@@ -24,13 +24,13 @@
 
 use glam::{DQuat, DVec3};
 
-use crate::body::Table;
-pub use crate::distance::CONTACT_DISTANCE;
-use crate::distance::{
+pub use crate::geometry::distance::CONTACT_DISTANCE;
+use crate::geometry::distance::{
     cover_gap, signed_distance, signed_distance_warm, table_signed_distance, ContactShape,
 };
-use crate::flight::FreeFlight;
-use crate::gjk::Warm;
+use crate::geometry::gjk::Warm;
+use crate::geometry::shape::Table;
+use crate::sim::flight::FreeFlight;
 
 /// Tolerance band (m) of the contact search between two bodies other than spheres: a
 /// contact (distance 0) is never missed, and the search stops, reporting a contact, at the
@@ -513,9 +513,9 @@ fn ball_table_closed_form(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::body::Shape;
-    use crate::distance::table_shape;
-    use crate::flight::{FlightConfig, FreeFlight};
+    use crate::geometry::distance::table_shape;
+    use crate::geometry::shape::Shape;
+    use crate::sim::flight::{FlightConfig, FreeFlight};
     use rapier3d::parry::shape::Ball;
     use std::sync::Arc;
 
@@ -1017,7 +1017,8 @@ mod tests {
         let shapes: Vec<ContactShape> = ["pawn", "rook", "queen", "knight"]
             .iter()
             .map(|p| {
-                let m = crate::body::load_obj(&dir.join(format!("{p}.obj")), 1.0).unwrap();
+                let m =
+                    crate::geometry::shape::load_obj(&dir.join(format!("{p}.obj")), 1.0).unwrap();
                 ContactShape::new(&Shape::Mesh(Arc::new(m)))
             })
             .collect();
@@ -1038,7 +1039,12 @@ mod tests {
                     // The f64 GJK decides (the function under test must not).
                     let (pa, pb) = (shapes[a].polytope().unwrap(), shapes[b].polytope().unwrap());
                     let inv = qa.inverse();
-                    let d = crate::gjk::distance_lower_bound(pa, pb, inv * qb, inv * (dir * mid));
+                    let d = crate::geometry::gjk::distance_lower_bound(
+                        pa,
+                        pb,
+                        inv * qb,
+                        inv * (dir * mid),
+                    );
                     if d > 0.0 {
                         hi = mid;
                     } else {

@@ -15,7 +15,7 @@
 //!   [`sym_eigen`], which stays accurate for tiny real objects.
 //! * [`Table`] is the axis-aligned box the bodies are launched from.
 //!
-//! How a body flies with these mass properties is [`crate::flight`]'s business.
+//! How a body flies with these mass properties is [`crate::sim::flight`]'s business.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -502,7 +502,7 @@ impl Table {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::flight::{FlightConfig, FreeFlight, RotationKind};
+    use crate::sim::flight::{FlightConfig, FreeFlight, RotationKind};
     use std::collections::HashMap;
     use std::f64::consts::PI;
 

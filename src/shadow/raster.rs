@@ -20,7 +20,7 @@
 //! clipped with Sutherland–Hodgman in homogeneous image coordinates (the slab planes and
 //! the four planes through the light and the image edges), then scan-converted per row.
 
-use crate::mask::Mask;
+use crate::shadow::mask::Mask;
 use glam::{DQuat, DVec2, DVec3};
 
 /// The receiver plane, its image rectangle and the point light. Construct with
@@ -604,7 +604,7 @@ impl ShadowCamera {
         for ((p, px), c) in verts
             .iter_mut()
             .zip(&mut pix)
-            .zip(crate::body::box_corners(he))
+            .zip(crate::geometry::shape::box_corners(he))
         {
             *p = center + rotation * c;
             let hv = self.homogeneous(*p);
@@ -1795,8 +1795,8 @@ mod tests {
         let (mut a, mut b) = (Mask::new(640, 480), Mask::new(640, 480));
         let mut compared = 0u64;
         for piece in ["pawn", "rook", "knight", "bishop", "queen", "king"] {
-            let mesh =
-                crate::body::load_obj(&dir.join(format!("{piece}.obj")), 1.0).expect("piece");
+            let mesh = crate::geometry::shape::load_obj(&dir.join(format!("{piece}.obj")), 1.0)
+                .expect("piece");
             let sil =
                 MeshSilhouette::new(&mesh.vertices, &mesh.triangles).expect("closed, oriented");
             for k in 0..40 {

@@ -5,7 +5,7 @@
 //! [`BudgetReport`] (what `budget.json` holds) and [`BudgetRun`] (the report plus the
 //! compensated launch and the Monte Carlo IoUs). [`run`] does everything:
 //!
-//! 1. **Re-simulation with drag** ([`crate::drag`]): every launched body's centre of mass
+//! 1. **Re-simulation with drag** ([`crate::sim::drag`]): every launched body's centre of mass
 //!    is flown from its vacuum launch state through air; its orientation stays the exact
 //!    torque-free one (drag torque is neglected, so the orientation error at `t` is zero
 //!    by construction and is reported as such). The shadow at `t` is the project's exact
@@ -41,12 +41,12 @@ use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::body::Shape;
-use crate::drag::{self, BodyDrag, DragConfig, DragError};
 use crate::energy::{self, Weights};
 use crate::evaluate::{launch_velocities, Problem, Workspace, MAX_TURN};
-use crate::flight::FreeFlight;
-use crate::solution::{check_solution, MismatchError, Solution};
+use crate::geometry::shape::Shape;
+use crate::output::solution::{check_solution, MismatchError, Solution};
+use crate::sim::drag::{self, BodyDrag, DragConfig, DragError};
+use crate::sim::flight::FreeFlight;
 
 /// The default IoU a shadow must reach to "read" as the picture
 /// ([`BudgetOptions::iou_threshold`]).
@@ -1397,7 +1397,7 @@ mod tests {
         -1.1, -0.3, 6.6, 2.0, -1.0, 4.0,
     ];
 
-    fn mask_of(p: &Problem, poses: &[(DVec3, DQuat)]) -> crate::mask::Mask {
+    fn mask_of(p: &Problem, poses: &[(DVec3, DQuat)]) -> crate::shadow::mask::Mask {
         let mut ws = p.workspace();
         ws.poses.copy_from_slice(poses);
         p.shadow(&mut ws);
@@ -1632,11 +1632,11 @@ mod tests {
         }
         let q = Problem::new(scene);
         let none = std::sync::atomic::AtomicUsize::new(0);
-        let opts = crate::solver::SolveOptions {
+        let opts = crate::optimize::solver::SolveOptions {
             threads: Some(1),
             ..Default::default()
         };
-        crate::solver::solve(&q, &opts, &mut crate::solver::Silent, &none).0
+        crate::optimize::solver::solve(&q, &opts, &mut crate::optimize::solver::Silent, &none).0
     }
 
     #[test]

@@ -4,8 +4,8 @@
 //! convex polytope with its sphere cover, built once per scene) and the functions
 //! [`signed_distance`] (two posed shapes) and [`table_signed_distance`] (a posed shape
 //! and the table). Separated shapes get a certified lower bound from the f64 GJK of
-//! [`crate::gjk`]; parry (f32) only supplies penetration depths, and never raises that
-//! bound. [`crate::contact`] builds its first-contact search on these queries, and scene
+//! [`crate::geometry::gjk`]; parry (f32) only supplies penetration depths, and never raises that
+//! bound. [`crate::sim::contact`] builds its first-contact search on these queries, and scene
 //! validation checks launch poses with them.
 
 use std::sync::Arc;
@@ -15,8 +15,8 @@ use rapier3d::parry::math::Pose;
 use rapier3d::parry::query;
 use rapier3d::parry::shape::{Ball, ConvexPolyhedron, Cuboid, Shape as ParryShape};
 
-use crate::body::{Shape, Table};
-use crate::gjk::{Polytope, Warm};
+use crate::geometry::gjk::{Polytope, Warm};
+use crate::geometry::shape::{Shape, Table};
 
 /// Surfaces closer than this (m) are in contact.
 pub const CONTACT_DISTANCE: f64 = 1e-6;
@@ -28,7 +28,7 @@ pub enum ContactShape {
     Ball(f64),
     /// Any other shape: as parry sees it in the body frame (used for penetration depths
     /// only), its convex hull's vertices in f64 (body frame; distances come from
-    /// [`crate::gjk`]), and a cover of spheres (body frame) whose union contains it.
+    /// [`crate::geometry::gjk`]), and a cover of spheres (body frame) whose union contains it.
     Parry(Arc<dyn ParryShape>, SphereCover, Option<Arc<Polytope>>),
 }
 
@@ -137,7 +137,7 @@ impl ContactShape {
             Shape::Sphere { radius } => ContactShape::Ball(*radius),
             Shape::Cuboid { half_extents } => {
                 let he = *half_extents;
-                let corners = crate::body::box_corners(he).to_vec();
+                let corners = crate::geometry::shape::box_corners(he).to_vec();
                 let edges: Vec<[usize; 2]> = (0..8usize)
                     .flat_map(|i| [1usize, 2, 4].map(move |b| [i, i | b]))
                     .filter(|[i, j]| i != j)
@@ -206,13 +206,13 @@ pub fn signed_distance(
         sb,
         pb,
         qb,
-        crate::gjk::REL_TOL,
+        crate::geometry::gjk::REL_TOL,
         &mut Warm::default(),
     )
 }
 
 /// [`signed_distance`] for a sequence of nearby poses of one pair: `warm` carries GJK's
-/// state from one query to the next (see [`crate::gjk::Warm`]).
+/// state from one query to the next (see [`crate::geometry::gjk::Warm`]).
 #[allow(clippy::too_many_arguments)]
 pub fn signed_distance_warm(
     sa: &ContactShape,
@@ -249,16 +249,16 @@ pub fn signed_distance_warm(
                     &ball_b
                 }
             };
-            // Separated shapes: the f64 GJK of `crate::gjk` on the hull vertices (a
+            // Separated shapes: the f64 GJK of `crate::geometry::gjk` on the hull vertices (a
             // ball is its centre, its radius subtracted). Only a penetration depth,
             // needed for bodies that touch at launch, comes from parry.
             let (va, vb) = (hull_points(sa), hull_points(sb));
             let certified = match (va, vb) {
                 (Some(va), Some(vb)) => {
-                    let d =
-                        crate::gjk::distance_lower_bound_warm(va, vb, rel_q, rel_p, rel_tol, warm)
-                            - ball_radius(sa)
-                            - ball_radius(sb);
+                    let d = crate::geometry::gjk::distance_lower_bound_warm(
+                        va, vb, rel_q, rel_p, rel_tol, warm,
+                    ) - ball_radius(sa)
+                        - ball_radius(sb);
                     if d > CONTACT_DISTANCE {
                         return d;
                     }
@@ -284,7 +284,7 @@ pub fn signed_distance_warm(
     }
 }
 
-/// The points whose convex hull is the shape, for [`crate::gjk`]: the hull's vertices,
+/// The points whose convex hull is the shape, for [`crate::geometry::gjk`]: the hull's vertices,
 /// or a ball's centre (its radius is subtracted from the distance).
 pub fn hull_points(s: &ContactShape) -> Option<&Polytope> {
     // Built once: a ball's centre in its own frame.
@@ -344,7 +344,7 @@ pub fn table_signed_distance(
 pub fn table_shape(table: &Table) -> ContactShape {
     // The table's queries never use a cover (see `sphere_clear_of_top`).
     let he = table.half_extents;
-    let corners = crate::body::box_corners(he).to_vec();
+    let corners = crate::geometry::shape::box_corners(he).to_vec();
     ContactShape::Parry(
         Arc::new(Cuboid::new(he.as_vec3())),
         Arc::new([]),

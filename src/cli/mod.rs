@@ -17,13 +17,13 @@ use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use crate::body::Shape;
 use crate::energy::{Term, Weights};
 use crate::evaluate::Problem;
-use crate::export;
+use crate::geometry::shape::Shape;
+use crate::optimize::solver::{self, IterationInfo, Observer, SolveOptions};
+use crate::output::files;
+use crate::output::solution::{self, SampleRecord, Solution};
 use crate::scene::{self, Scene, Stage, Strategy};
-use crate::solution::{self, SampleRecord, Solution};
-use crate::solver::{self, IterationInfo, Observer, SolveOptions};
 
 #[derive(Parser)]
 #[command(
@@ -75,7 +75,7 @@ enum Command {
         #[arg(long)]
         scene: Option<PathBuf>,
         /// Seconds of rapier continuation after t.
-        #[arg(long, default_value_t = crate::trajectory::DEFAULT_AFTER)]
+        #[arg(long, default_value_t = crate::output::trajectory::DEFAULT_AFTER)]
         after: f64,
     },
     /// Render the shadow at t with Blender Cycles and compare it with the rasterizer (IoU, XOR).
@@ -133,7 +133,7 @@ enum Command {
         #[arg(long)]
         threads: Option<usize>,
         /// Air density (kg/m^3).
-        #[arg(long, default_value_t = crate::drag::AIR_DENSITY, allow_negative_numbers = true)]
+        #[arg(long, default_value_t = crate::sim::drag::AIR_DENSITY, allow_negative_numbers = true)]
         rho: f64,
         /// Drag coefficient for every body [default: sphere 0.47, box 1.05, mesh 1.0].
         #[arg(long, allow_negative_numbers = true)]
@@ -231,7 +231,7 @@ pub fn run(cli: Cli) -> Result<()> {
             iou_threshold,
             quiet,
         } => {
-            let mut drag = crate::drag::DragConfig {
+            let mut drag = crate::sim::drag::DragConfig {
                 rho,
                 magnus,
                 ..Default::default()
@@ -386,7 +386,7 @@ static INTERRUPTS: AtomicUsize = AtomicUsize::new(0);
 
 struct CliObserver {
     out: PathBuf,
-    target: crate::mask::Mask,
+    target: crate::shadow::mask::Mask,
     stage_names: Vec<String>,
     prior: Vec<SampleRecord>,
     bar: Option<ProgressBar>,
@@ -428,7 +428,7 @@ impl Observer for CliObserver {
         // iteration would cost more than the optimisation itself on small scenes.
         if self.last_preview.elapsed().as_secs_f64() >= 0.1 {
             self.last_preview = Instant::now();
-            if let Err(e) = export::write_preview(&self.out, &self.target, info.best_shadow) {
+            if let Err(e) = files::write_preview(&self.out, &self.target, info.best_shadow) {
                 self.error.get_or_insert(e.into());
             }
         }
@@ -446,8 +446,8 @@ impl Observer for CliObserver {
         }
         let mut all = self.prior.clone();
         all.extend_from_slice(records);
-        let res = export::write_solution(&self.out, s)
-            .and_then(|_| export::write_convergence(&self.out, &self.stage_names, &all));
+        let res = files::write_solution(&self.out, s)
+            .and_then(|_| files::write_convergence(&self.out, &self.stage_names, &all));
         if let Err(e) = res {
             self.error.get_or_insert(e.into());
         }
@@ -475,7 +475,7 @@ fn solve(
     let mut prior = Vec::new();
     let resume_from = if resume {
         let file = out.join("solution.json");
-        let s = export::read_solution(&file)
+        let s = files::read_solution(&file)
             .with_context(|| format!("cannot resume from {}", out.display()))?;
         solution::check_resumable(scene, &s)
             .with_context(|| format!("cannot resume from {}", file.display()))?;
@@ -489,7 +489,7 @@ fn solve(
         }
         let conv = out.join("convergence.csv");
         if conv.exists() {
-            prior = export::read_convergence(&conv, s.stages_completed)?;
+            prior = files::read_convergence(&conv, s.stages_completed)?;
         }
         eprintln!(
             "resuming after stage {}/{}",
@@ -533,14 +533,19 @@ fn solve(
     }
     let mut all = prior;
     all.extend(records);
-    export::write_solution(&out, &solution)?;
-    export::write_convergence(&out, &observer.stage_names, &all)?;
+    files::write_solution(&out, &solution)?;
+    files::write_convergence(&out, &observer.stage_names, &all)?;
     let mut ws = problem.workspace();
     let params = solution.parameters();
     problem.evaluate(&params, &Weights::all_ones(), &mut ws);
-    export::write_pictures(&out, &scene.target, &ws.mask)?;
-    export::write_preview(&out, &scene.target, &ws.mask)?;
-    let exported = write_exports(&out, &problem, &solution, crate::trajectory::DEFAULT_AFTER)?;
+    files::write_pictures(&out, &scene.target, &ws.mask)?;
+    files::write_preview(&out, &scene.target, &ws.mask)?;
+    let exported = write_exports(
+        &out,
+        &problem,
+        &solution,
+        crate::output::trajectory::DEFAULT_AFTER,
+    )?;
     println!(
         "{}: IoU at t {:.4}, {} before t ({} contacts), {} samples in {} iterations, {:.2} s on {} threads{}",
         scene.name,
@@ -593,7 +598,7 @@ fn load_solution_and_scene(
             dir.display()
         );
     }
-    let solution = export::read_solution(file)?;
+    let solution = files::read_solution(file)?;
     let scene_path = match scene {
         Some(p) => p.to_path_buf(),
         None => solution
@@ -610,24 +615,24 @@ fn load_solution_and_scene(
 /// `<scene>.glb`, `launch.csv` and `trajectory.csv`; returns a one-line summary.
 fn write_exports(dir: &Path, problem: &Problem, solution: &Solution, after: f64) -> Result<String> {
     let params = solution.parameters();
-    let track = crate::trajectory::track(problem, &params, after);
+    let track = crate::output::trajectory::track(problem, &params, after);
     let name = &problem.scene.name;
-    let traj = crate::gltf_export::Trajectory {
+    let traj = crate::output::gltf::Trajectory {
         times: track.times.clone(),
         poses: track.poses.clone(),
         t_index: track.t_index,
         fps: track.fps,
     };
-    let glb = crate::gltf_export::write_glb(&problem.scene, &traj)
+    let glb = crate::output::gltf::write_glb(&problem.scene, &traj)
         .context("cannot build the glTF file")?;
-    export::write_atomic(&dir.join(format!("{name}.glb")), &glb)?;
-    export::write_csv(
+    files::write_atomic(&dir.join(format!("{name}.glb")), &glb)?;
+    files::write_csv(
         &dir.join("launch.csv"),
-        &crate::trajectory::launch_rows(problem, &params),
+        &crate::output::trajectory::launch_rows(problem, &params),
     )?;
-    export::write_csv(
+    files::write_csv(
         &dir.join("trajectory.csv"),
-        &crate::trajectory::trajectory_rows(problem, &track),
+        &crate::output::trajectory::trajectory_rows(problem, &track),
     )?;
     Ok(format!(
         "wrote {}/{{{name}.glb, launch.csv, trajectory.csv}}: {} keys, t = {} s at key {}",
@@ -722,7 +727,7 @@ fn glb_path(dir: &Path, problem: &Problem) -> Result<PathBuf> {
             dir.display()
         );
     }
-    crate::gltf_export::read_poses_at(
+    crate::output::gltf::read_poses_at(
         &std::fs::read(&glb).with_context(|| format!("cannot read {}", glb.display()))?,
         0.0,
     )
@@ -765,7 +770,7 @@ fn validate(dir: &Path, scene: Option<&Path>, python: Option<PathBuf>) -> Result
             target.height()
         );
     }
-    let cycles = crate::mask::Mask::from_fn(target.width(), target.height(), |x, y| {
+    let cycles = crate::shadow::mask::Mask::from_fn(target.width(), target.height(), |x, y| {
         img.get_pixel(x as u32, y as u32).0[0] < 128
     });
     let mut ws = problem.workspace();
@@ -773,13 +778,13 @@ fn validate(dir: &Path, scene: Option<&Path>, python: Option<PathBuf>) -> Result
     let ours = &ws.mask;
     let iou = crate::energy::iou(&cycles, ours);
     let xor = cycles.xor_count(ours);
-    let diff = crate::picture::difference_image(
+    let diff = crate::output::picture::difference_image(
         target.width(),
         target.height(),
         &|x, y| cycles.get(x, y),
         &|x, y| ours.get(x, y),
     );
-    export::save_png(&diff, &dir.join("validate_diff.png"))?;
+    files::save_png(&diff, &dir.join("validate_diff.png"))?;
     let report = serde_json::json!({
         "scene": problem.scene.name,
         "iou": iou,
@@ -790,7 +795,7 @@ fn validate(dir: &Path, scene: Option<&Path>, python: Option<PathBuf>) -> Result
         "difference_image": dir.join("validate_diff.png").display().to_string(),
         "blender": result,
     });
-    export::write_atomic(
+    files::write_atomic(
         &dir.join("validate.json"),
         serde_json::to_string_pretty(&report)?.as_bytes(),
     )?;
@@ -874,7 +879,7 @@ fn eval(
 ) -> Result<()> {
     let scene = load_scene(scene_path)?;
     let problem = Problem::new(scene);
-    let s = export::read_solution(solution_path)?;
+    let s = files::read_solution(solution_path)?;
     solution::check_solution(&problem.scene, &s)
         .with_context(|| format!("{} does not match the scene", solution_path.display()))?;
     let scene = &problem.scene;
@@ -1017,7 +1022,7 @@ fn budget(
     quiet: bool,
 ) -> Result<()> {
     use crate::budget;
-    use crate::picture::{self, Series};
+    use crate::output::picture::{self, Series};
     let (dir, file) = if path.is_file() {
         let dir = path
             .parent()
@@ -1046,14 +1051,14 @@ fn budget(
     let r = &run.report;
 
     // launch_drag.csv: the launch table of the compensated launch, its pose at t with drag.
-    let mut rows = crate::trajectory::launch_rows(&problem, &run.compensated);
+    let mut rows = crate::output::trajectory::launch_rows(&problem, &run.compensated);
     for (row, com) in rows.iter_mut().zip(&run.compensated_com) {
         row.com_at_t_x_m = com.x;
         row.com_at_t_y_m = com.y;
         row.com_at_t_z_m = com.z;
     }
-    export::write_csv(&dir.join("launch_drag.csv"), &rows)?;
-    export::write_atomic(
+    files::write_csv(&dir.join("launch_drag.csv"), &rows)?;
+    files::write_atomic(
         &dir.join("budget.json"),
         serde_json::to_string_pretty(r)?.as_bytes(),
     )?;
@@ -1065,7 +1070,7 @@ fn budget(
                 .map(|n| n.get())
                 .unwrap_or(1))
     ));
-    export::write_atomic(&dir.join("budget.md"), md.as_bytes())?;
+    files::write_atomic(&dir.join("budget.md"), md.as_bytes())?;
     let h = &r.histogram;
     let hist = picture::histogram_plot(
         &format!("{}: IoU at t, {} samples", r.scene, r.monte_carlo.samples),
@@ -1082,7 +1087,7 @@ fn budget(
         640,
         400,
     );
-    export::save_png(&hist, &dir.join("budget_hist.png"))?;
+    files::save_png(&hist, &dir.join("budget_hist.png"))?;
     if let Some(se) = &r.search {
         let panels: Vec<image::RgbImage> = se
             .single
@@ -1120,7 +1125,7 @@ fn budget(
             })
             .collect();
         let refs: Vec<&image::RgbImage> = panels.iter().collect();
-        export::save_png(
+        files::save_png(
             &picture::side_by_side(&refs, 0),
             &dir.join("budget_tolerances.png"),
         )?;

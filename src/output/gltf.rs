@@ -26,7 +26,7 @@ use gltf::json;
 use json::validation::{Checked::Valid, USize64};
 use json::Index;
 
-use crate::body::{Shape, TriMesh};
+use crate::geometry::shape::{Shape, TriMesh};
 use crate::scene::Scene;
 
 /// Value of `asset.generator` and of the scene extras' `generator`.
@@ -1526,7 +1526,7 @@ mod tests {
     }
 
     /// Writes sample files for the Khronos validator and Blender (not run in CI):
-    /// `cargo test --lib gltf_export::tests::write_sample_glbs -- --ignored`, then
+    /// `cargo test --lib output::gltf::tests::write_sample_glbs -- --ignored`, then
     /// validate `/tmp/gltf/*.glb` (see docs/gltf.md). `BSA_GLTF_SCENE=<dir>` adds a scene.
     #[test]
     #[ignore]

@@ -20,7 +20,7 @@
 //!   (`= 1 / (2 + 1/S)`, Sawicki, Hubbard and Stronge's baseball fit, which has the right
 //!   limits: `C_L ~ S` for slow spin, 1/2 for fast spin). It needs no division by `|v|`.
 //! * No drag torque: the rotation stays the exact torque-free one of
-//!   [`crate::flight::FreeFlight`] (a sphere keeps its spin, so the Magnus axis is fixed).
+//!   [`crate::sim::flight::FreeFlight`] (a sphere keeps its spin, so the Magnus axis is fixed).
 //!
 //! The integrator is classical RK4 on a uniform grid of at most
 //! [`DragConfig::max_step`] seconds. Measured against the closed forms of vertical
@@ -34,7 +34,7 @@
 use glam::DVec3;
 use serde::Serialize;
 
-use crate::body::Shape;
+use crate::geometry::shape::Shape;
 
 /// Air density at 20 C and sea level (kg/m^3).
 pub const AIR_DENSITY: f64 = 1.204;
@@ -151,7 +151,7 @@ pub fn reference_area(shape: &Shape) -> f64 {
 /// Surface area of the convex hull of points (m^2): parry's hull (in f32, about the
 /// centroid of the points, so relative precision ~1e-7), its triangle areas summed in f64.
 /// Falls back to the mesh's own area if parry finds the hull degenerate.
-fn hull_area(mesh: &crate::body::TriMesh) -> f64 {
+fn hull_area(mesh: &crate::geometry::shape::TriMesh) -> f64 {
     use rapier3d::parry::transformation::try_convex_hull;
     let points = &mesh.vertices;
     if points.len() < 4 {
@@ -453,7 +453,7 @@ mod tests {
                 if i & 4 == 0 { -h.z } else { h.z },
             ));
         }
-        let mesh = crate::body::TriMesh::new(v, Vec::new());
+        let mesh = crate::geometry::shape::TriMesh::new(v, Vec::new());
         let a = reference_area(&Shape::Mesh(std::sync::Arc::new(mesh)));
         // parry's hull is in f32: relative precision ~1e-7.
         assert!((a / reference_area(&b) - 1.0).abs() < 1e-6, "{a}");

@@ -389,7 +389,7 @@ mod tests {
     use super::*;
 
     fn box_polytope(he: DVec3) -> Polytope {
-        Polytope::new(crate::body::box_corners(he).to_vec(), &[])
+        Polytope::new(crate::geometry::shape::box_corners(he).to_vec(), &[])
     }
 
     /// Tiny deterministic generator for the tests.

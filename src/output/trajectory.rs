@@ -6,15 +6,15 @@
 //! ([`Problem::fly`] and [`Problem::state_at`]: exact free flight, landings absorbed by the
 //! table), with a key at every timestep and one exactly at `t`, so that the animation
 //! shows at `t` exactly the shadow the solver scored. From `t` on, rapier3d continues the
-//! motion with collisions, landing and bouncing ([`crate::continuation`]), by default for
+//! motion with collisions, landing and bouncing ([`crate::sim::continuation`]), by default for
 //! one second.
 
 use glam::{DQuat, DVec3};
 use serde::Serialize;
 
-use crate::body::Shape;
-use crate::continuation::{self, BodyState, ContinuationConfig};
 use crate::evaluate::{launch_velocities, Problem};
+use crate::geometry::shape::Shape;
+use crate::sim::continuation::{self, BodyState, ContinuationConfig};
 
 /// Poses at every key: `poses[k][i]` is occluder `i` at `times[k]` (body origin,
 /// body -> world orientation, Z-up world).

@@ -1,0 +1,11 @@
+//! What a solve leaves behind: [`solution`] (the schema of `solution.json` and
+//! `convergence.csv`, and the check that a solution belongs to a scene), [`files`]
+//! (atomic writes and reads of the output folder), [`trajectory`] (the whole motion and
+//! the launch and trajectory tables), [`gltf`] (the animated glTF 2.0 file) and
+//! [`picture`] (overlays and plots for people).
+
+pub mod files;
+pub mod gltf;
+pub mod picture;
+pub mod solution;
+pub mod trajectory;
