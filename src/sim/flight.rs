@@ -12,7 +12,7 @@
 //! * isotropic inertia (sphere, cube): `R(t) = exp(w t) R0`, exact;
 //! * axisymmetric inertia (two equal principal moments `I_perp`, symmetry axis `a` in the
 //!   body frame, moment `I_a` about it): `R(t) = exp(t L / I_perp) R0 exp(t beta a)` with
-//!   `beta = (a . w_body(0)) (1 - I_a / I_perp)`, exact (the derivation is in `BODY.md`);
+//!   `beta = (a . w_body(0)) (1 - I_a / I_perp)`, exact (the derivation is in `docs/flight.md`);
 //! * asymmetric inertia: `q' = q (0, w_p) / 2` with `w_p = I^-1 q^* L q` for the
 //!   principal-frame quaternion `q`, integrated by RK4 on a uniform grid over
 //!   `[0, t_max]` at reset; a query is one partial RK4 step from the grid state just
@@ -73,7 +73,7 @@ pub struct FlightConfig {
     /// Largest rotation per step in radians (default 0.02 rad: for a tumbling brick at
     /// ~20 rad/s, measured orientation error 7e-7 rad and relative energy drift 1.1e-9
     /// after 2 s; both scale as the fourth power of this value, the cost inversely; see
-    /// `BODY.md` for the table).
+    /// `docs/flight.md` for the table).
     pub rk4_max_angle: f64,
 }
 
@@ -282,7 +282,7 @@ impl FreeFlight {
         if let Some(k) = symmetric_axis {
             // Regular precession. With n(t) the world symmetry axis, w = L / I_perp +
             // beta n solves Euler's equations: it makes I(t) w = L, and n rotates about L
-            // so that n . L = I_a w_a stays constant. See BODY.md for the derivation.
+            // so that n . L = I_a w_a stays constant. See docs/flight.md for the derivation.
             let i_perp = 0.5 * (inertia.element_sum() - inertia[k]);
             let beta = w_principal[k] * (1.0 - inertia[k] / i_perp);
             let mut e = DVec3::ZERO;
