@@ -1,0 +1,130 @@
+//! The scene file as serde reads it. Unknown fields are rejected everywhere so that a
+//! misspelt option is an error instead of being silently ignored; [`super::validate`]
+//! turns these into the validated types.
+
+use std::collections::HashMap;
+
+use serde::Deserialize;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawScene {
+    pub(super) name: Option<String>,
+    pub(super) target: String,
+    pub(super) t: f64,
+    pub(super) timestep: Option<f64>,
+    pub(super) gravity: Option<[f64; 3]>,
+    pub(super) light: [f64; 3],
+    pub(super) receiver: RawReceiver,
+    pub(super) table: Option<RawTable>,
+    pub(super) occluders: Vec<RawOccluder>,
+    #[serde(default)]
+    pub(super) hints: Option<RawHints>,
+    pub(super) start: Option<RawStart>,
+    pub(super) stages: Option<Vec<RawStage>>,
+    pub(super) strategy: Option<RawStrategy>,
+    pub(super) seed: Option<u64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawReceiver {
+    pub(super) center: [f64; 3],
+    pub(super) u: [f64; 3],
+    pub(super) v: [f64; 3],
+    pub(super) width: f64,
+    pub(super) height: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawTable {
+    pub(super) center: [f64; 3],
+    pub(super) size: [f64; 3],
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "snake_case")]
+pub(super) enum RawShape {
+    Sphere { radius: f64 },
+    Box { size: [f64; 3] },
+    Mesh { obj: String, scale: Option<f64> },
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawOccluder {
+    pub(super) name: String,
+    pub(super) shape: RawShape,
+    pub(super) position: [f64; 3],
+    pub(super) orientation: Option<[f64; 4]>,
+    pub(super) mass: Option<f64>,
+    pub(super) density: Option<f64>,
+    pub(super) launched: Option<bool>,
+    pub(super) start_velocity: Option<[f64; 3]>,
+    pub(super) start_angular_velocity: Option<[f64; 3]>,
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+pub(super) enum RawHints {
+    File(String),
+    Inline(Vec<RawHint>),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawHint {
+    pub(super) occluder: String,
+    pub(super) point: [f64; 3],
+    pub(super) pixel: [f64; 2],
+    pub(super) weight: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawStart {
+    pub(super) rise: Option<f64>,
+    pub(super) aim: Option<String>,
+}
+
+#[derive(Deserialize, Clone)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawStage {
+    pub(super) name: Option<String>,
+    pub(super) weights: HashMap<String, f64>,
+    pub(super) vary: Option<RawVary>,
+    pub(super) step: Option<f64>,
+    pub(super) max_iterations: Option<usize>,
+    pub(super) population: Option<usize>,
+    pub(super) target_energy: Option<f64>,
+    pub(super) tol_fun: Option<f64>,
+    pub(super) stagnation: Option<usize>,
+}
+
+#[derive(Deserialize, Clone)]
+#[serde(untagged)]
+pub(super) enum RawVary {
+    All(String),
+    Names(Vec<String>),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, tag = "kind", rename_all = "snake_case")]
+pub(super) enum RawStrategy {
+    Scheduled,
+    Sequential {
+        order: Option<RawOrder>,
+        rounds: Option<u32>,
+        stage: Box<RawStage>,
+        #[serde(rename = "final")]
+        final_stage: Option<Box<RawStage>>,
+    },
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+pub(super) enum RawOrder {
+    Auto(String),
+    Names(Vec<String>),
+}

@@ -1,0 +1,674 @@
+//! Validation: the raw scene in, a [`Scene`] out, with every field checked and every
+//! error naming the file and the field ([`SceneError`]).
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{DQuat, DVec2, DVec3};
+
+use super::raw::*;
+use super::start::{auto_order, raw_start_overrides, Aim};
+use super::*;
+use crate::energy::{Term, Weights, TERM_COUNT};
+use crate::geometry::distance::{
+    signed_distance, table_shape, table_signed_distance, ContactShape,
+};
+use crate::geometry::shape::{self, Shape, TriMesh};
+use crate::shadow::mask::Mask;
+use crate::shadow::raster::ShadowCamera;
+
+pub(super) struct Validator<'a> {
+    pub(super) file: &'a Path,
+    pub(super) dir: &'a Path,
+}
+
+impl Validator<'_> {
+    fn field_err(&self, field: impl Into<String>, reason: impl Into<String>) -> SceneError {
+        SceneError::Field {
+            path: self.file.to_path_buf(),
+            field: field.into(),
+            reason: reason.into(),
+        }
+    }
+
+    fn finite(&self, field: &str, x: f64) -> Result<f64> {
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(self.field_err(field, format!("must be a finite number, got {x}")))
+        }
+    }
+
+    fn positive(&self, field: &str, x: f64) -> Result<f64> {
+        let x = self.finite(field, x)?;
+        if x > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.field_err(field, format!("must be positive, got {x}")))
+        }
+    }
+
+    fn non_negative(&self, field: &str, x: f64) -> Result<f64> {
+        let x = self.finite(field, x)?;
+        if x >= 0.0 {
+            Ok(x)
+        } else {
+            Err(self.field_err(field, format!("must not be negative, got {x}")))
+        }
+    }
+
+    fn vec3(&self, field: &str, a: [f64; 3]) -> Result<DVec3> {
+        for (i, x) in a.iter().enumerate() {
+            self.finite(&format!("{field}[{i}]"), *x)?;
+        }
+        Ok(DVec3::from_array(a))
+    }
+
+    fn unit(&self, field: &str, a: [f64; 3]) -> Result<DVec3> {
+        let v = self.vec3(field, a)?;
+        let len = v.length();
+        if len < 1e-12 {
+            return Err(self.field_err(field, "must be a non-zero vector"));
+        }
+        Ok(v / len)
+    }
+
+    fn resolve(&self, rel: &str) -> PathBuf {
+        let p = Path::new(rel);
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            self.dir.join(p)
+        }
+    }
+
+    pub(super) fn scene(&self, raw: RawScene, default_name: String) -> Result<Scene> {
+        let name = raw.name.clone().unwrap_or(default_name);
+        if name.is_empty() || name == "." || name == ".." || name.contains(['/', '\\']) {
+            return Err(self.field_err("name", "must be a non-empty name without path separators"));
+        }
+        let t = self.positive("t", raw.t)?;
+        let dt = self.positive("timestep", raw.timestep.unwrap_or(DEFAULT_TIMESTEP))?;
+        if dt > t {
+            return Err(self.field_err("timestep", format!("must not exceed t = {t} s, got {dt}")));
+        }
+        let gravity = self.vec3("gravity", raw.gravity.unwrap_or(DEFAULT_GRAVITY))?;
+        let light = self.vec3("light", raw.light)?;
+        let receiver = self.receiver(&raw.receiver, light)?;
+        let target = self.target(&raw.target)?;
+        let camera = ShadowCamera::new(
+            light,
+            receiver.center,
+            receiver.u,
+            receiver.v,
+            receiver.width,
+            receiver.height,
+            target.width(),
+            target.height(),
+        );
+        let table = match &raw.table {
+            None => None,
+            Some(tb) => {
+                let center = self.vec3("table.center", tb.center)?;
+                let mut half = DVec3::ZERO;
+                for i in 0..3 {
+                    half[i] = self.positive(&format!("table.size[{i}]"), tb.size[i])? / 2.0;
+                }
+                Some(Table {
+                    center,
+                    half_extents: half,
+                })
+            }
+        };
+        let rise = self.finite(
+            "start.rise",
+            raw.start
+                .as_ref()
+                .and_then(|s| s.rise)
+                .unwrap_or(DEFAULT_START_RISE),
+        )?;
+        let mut occluders = Vec::with_capacity(raw.occluders.len());
+        if raw.occluders.is_empty() {
+            return Err(self.field_err("occluders", "needs at least one occluder"));
+        }
+        for (i, ro) in raw.occluders.iter().enumerate() {
+            let o = self.occluder(i, ro, t, gravity, rise)?;
+            if RESERVED_NAMES.contains(&o.name.as_str()) {
+                return Err(self.field_err(
+                    format!("occluders[{i}].name"),
+                    format!(
+                        "`{}` is the name of a node of the glTF export; occluders may not use {}",
+                        o.name,
+                        RESERVED_NAMES.map(|n| format!("`{n}`")).join(", ")
+                    ),
+                ));
+            }
+            if occluders.iter().any(|p: &Occluder| p.name == o.name) {
+                return Err(self.field_err(
+                    format!("occluders[{i}].name"),
+                    format!(
+                        "`{}` is used by two occluders; names must be unique",
+                        o.name
+                    ),
+                ));
+            }
+            occluders.push(o);
+        }
+        if !occluders.iter().any(|o| o.launched) {
+            return Err(self.field_err(
+                "occluders",
+                "no occluder is launched; there is nothing to optimise",
+            ));
+        }
+        self.check_overlaps(&occluders, table.as_ref())?;
+        let hints = match &raw.hints {
+            None => Vec::new(),
+            Some(RawHints::Inline(list)) => list
+                .iter()
+                .enumerate()
+                .map(|(i, h)| self.hint(&format!("hints[{i}]"), h, &occluders))
+                .collect::<Result<_>>()?,
+            Some(RawHints::File(rel)) => self.hints_file(&self.resolve(rel), &occluders)?,
+        };
+        let aim = raw
+            .start
+            .as_ref()
+            .and_then(|s| s.aim.clone())
+            .unwrap_or_else(|| "hints".to_string());
+        match aim.as_str() {
+            "hints" => Aim {
+                camera: &camera,
+                receiver: &receiver,
+                t,
+                gravity,
+                rise,
+            }
+            .apply(&mut occluders, &hints, &raw_start_overrides(&raw)),
+            "up" => {}
+            other => {
+                return Err(self.field_err(
+                    "start.aim",
+                    format!("must be \"hints\" or \"up\", got \"{other}\""),
+                ))
+            }
+        }
+        let (stages, strategy) = self.stages(&raw, &occluders)?;
+        Ok(Scene {
+            name,
+            source: self.file.to_path_buf(),
+            target,
+            t,
+            dt,
+            gravity,
+            light,
+            receiver,
+            camera,
+            table,
+            occluders,
+            hints,
+            stages,
+            strategy,
+            seed: raw.seed.unwrap_or(1),
+        })
+    }
+
+    fn receiver(&self, r: &RawReceiver, light: DVec3) -> Result<Receiver> {
+        let center = self.vec3("receiver.center", r.center)?;
+        let u = self.unit("receiver.u", r.u)?;
+        let v = self.unit("receiver.v", r.v)?;
+        if u.dot(v).abs() > 1e-6 {
+            return Err(self.field_err("receiver.v", "must be perpendicular to receiver.u"));
+        }
+        let width = self.positive("receiver.width", r.width)?;
+        let height = self.positive("receiver.height", r.height)?;
+        let normal = u.cross(v).normalize();
+        let h = (light - center).dot(normal);
+        // The image is seen from the light's side with u to the right and v up, so the
+        // light must be strictly in front of the receiver (on the side of u x v).
+        if h <= 1e-9 {
+            return Err(self.field_err(
+                "light",
+                format!(
+                    "the light is on or behind the receiver plane (its height above the plane along u x v is {h:.4} m); it must be in front"
+                ),
+            ));
+        }
+        Ok(Receiver {
+            center,
+            u,
+            v,
+            normal,
+            width,
+            height,
+        })
+    }
+
+    fn target(&self, rel: &str) -> Result<Mask> {
+        let path = self.resolve(rel);
+        let bytes = std::fs::read(&path).map_err(|source| SceneError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+            .map_err(|e| SceneError::TargetNotPng {
+                path: path.clone(),
+                reason: e.to_string(),
+            })?
+            .to_rgba8();
+        let (w, h) = (img.width() as usize, img.height() as usize);
+        if w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE {
+            return Err(SceneError::TargetNotPng {
+                path,
+                reason: format!("{w} x {h} pixels is larger than the {MAX_IMAGE_SIDE} x {MAX_IMAGE_SIDE} supported"),
+            });
+        }
+        let mask = Mask::from_fn(w, h, |x, y| {
+            let p = img.get_pixel(x as u32, y as u32).0;
+            // Rec. 709 luma of the 8-bit values; dark means below half luminance, and a
+            // (mostly) transparent pixel is never shadow.
+            let luma = 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+            p[3] >= 128 && luma < 127.5
+        });
+        if mask.count() == 0 {
+            return Err(SceneError::TargetEmpty { path });
+        }
+        Ok(mask)
+    }
+
+    fn occluder(
+        &self,
+        i: usize,
+        ro: &RawOccluder,
+        t: f64,
+        gravity: DVec3,
+        rise: f64,
+    ) -> Result<Occluder> {
+        let f = |s: &str| format!("occluders[{i}].{s}");
+        if ro.name.trim().is_empty() {
+            return Err(self.field_err(f("name"), "must not be empty"));
+        }
+        let shape = match &ro.shape {
+            RawShape::Sphere { radius } => Shape::Sphere {
+                radius: self.positive(&f("shape.sphere.radius"), *radius)?,
+            },
+            RawShape::Box { size } => {
+                let mut half = DVec3::ZERO;
+                for k in 0..3 {
+                    half[k] = self.positive(&f(&format!("shape.box.size[{k}]")), size[k])? / 2.0;
+                }
+                Shape::Cuboid { half_extents: half }
+            }
+            RawShape::Mesh { obj, scale } => {
+                let scale = self.positive(&f("shape.mesh.scale"), scale.unwrap_or(1.0))?;
+                let path = self.resolve(obj);
+                let mesh: TriMesh =
+                    shape::load_obj(&path, scale).map_err(|source| SceneError::Obj {
+                        path: path.clone(),
+                        field: f("shape.mesh.obj"),
+                        source,
+                    })?;
+                Shape::Mesh(Arc::new(mesh))
+            }
+        };
+        let position = self.vec3(&f("position"), ro.position)?;
+        let orientation = match ro.orientation {
+            None => DQuat::IDENTITY,
+            Some(q) => {
+                for (k, x) in q.iter().enumerate() {
+                    self.finite(&f(&format!("orientation[{k}]")), *x)?;
+                }
+                let q = DQuat::from_xyzw(q[0], q[1], q[2], q[3]);
+                if q.length() < 1e-9 {
+                    return Err(self.field_err(
+                        f("orientation"),
+                        "must be a non-zero quaternion [x, y, z, w]",
+                    ));
+                }
+                q.normalize()
+            }
+        };
+        let volume = shape.volume();
+        let density = match (ro.mass, ro.density) {
+            (Some(m), None) => self.positive(&f("mass"), m)? / volume,
+            (None, Some(d)) => self.positive(&f("density"), d)?,
+            (None, None) => {
+                return Err(
+                    self.field_err(f("mass"), "give either `mass` (kg) or `density` (kg/m^3)")
+                )
+            }
+            (Some(_), Some(_)) => {
+                return Err(
+                    self.field_err(f("density"), "give either `mass` or `density`, not both")
+                )
+            }
+        };
+        let mass = shape.mass_properties_checked(density).ok_or_else(|| {
+            self.field_err(
+                f("shape"),
+                "is too small or too large to give a finite, positive mass and inertia",
+            )
+        })?;
+        let launched = ro.launched.unwrap_or(true);
+        // The default start guess launches straight up so that the centre of mass is
+        // `rise` metres higher at t: a neutral, collision-free, in-view starting point.
+        let g_up = -gravity.z;
+        let default_v = DVec3::new(0.0, 0.0, (rise + 0.5 * g_up * t * t) / t);
+        let start_velocity = match ro.start_velocity {
+            Some(v) => self.vec3(&f("start_velocity"), v)?,
+            None => default_v,
+        };
+        let start_angular_velocity = match ro.start_angular_velocity {
+            Some(w) => self.vec3(&f("start_angular_velocity"), w)?,
+            None => DVec3::ZERO,
+        };
+        let bounding_radius = shape.bounding_radius(mass.local_com);
+        Ok(Occluder {
+            name: ro.name.clone(),
+            shape,
+            mass,
+            position,
+            orientation,
+            launched,
+            start_velocity,
+            start_angular_velocity,
+            bounding_radius,
+        })
+    }
+
+    fn check_overlaps(&self, occ: &[Occluder], table: Option<&Table>) -> Result<()> {
+        // Tolerance for resting contact: bodies may touch (a ball on the floor) but not
+        // interpenetrate by more than a tenth of a millimetre.
+        const TOL: f64 = 1e-4;
+        for i in 0..occ.len() {
+            for j in (i + 1)..occ.len() {
+                let (a, b) = (&occ[i], &occ[j]);
+                let (sa, sb) = (ContactShape::new(&a.shape), ContactShape::new(&b.shape));
+                let d = signed_distance(
+                    &sa,
+                    a.position,
+                    a.orientation,
+                    &sb,
+                    b.position,
+                    b.orientation,
+                );
+                if d < -TOL {
+                    return Err(SceneError::Overlap {
+                        path: self.file.to_path_buf(),
+                        what: format!("occluders `{}` and `{}`", occ[i].name, occ[j].name),
+                        depth: -d,
+                    });
+                }
+            }
+            if let Some(tb) = table {
+                let o = &occ[i];
+                let s = ContactShape::new(&o.shape);
+                let d = table_signed_distance(&s, o.position, o.orientation, tb, &table_shape(tb));
+                if d < -TOL {
+                    return Err(SceneError::Overlap {
+                        path: self.file.to_path_buf(),
+                        what: format!("occluder `{}` and the table", occ[i].name),
+                        depth: -d,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn hint(&self, field: &str, h: &RawHint, occ: &[Occluder]) -> Result<Hint> {
+        let occluder = occ
+            .iter()
+            .position(|o| o.name == h.occluder)
+            .ok_or_else(|| {
+                self.field_err(
+                    format!("{field}.occluder"),
+                    format!("names occluder `{}`, which does not exist", h.occluder),
+                )
+            })?;
+        let point = self.vec3(&format!("{field}.point"), h.point)?;
+        let px = self.finite(&format!("{field}.pixel[0]"), h.pixel[0])?;
+        let py = self.finite(&format!("{field}.pixel[1]"), h.pixel[1])?;
+        let weight = self.non_negative(&format!("{field}.weight"), h.weight.unwrap_or(1.0))?;
+        Ok(Hint {
+            occluder,
+            point,
+            pixel: DVec2::new(px, py),
+            weight,
+        })
+    }
+
+    /// Hints in a text file, one per line: `occluder x y z px py [weight]`; `#` starts a
+    /// comment. This is the paper's "hints stored separately in a text file".
+    fn hints_file(&self, path: &Path, occ: &[Occluder]) -> Result<Vec<Hint>> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let mut out = Vec::new();
+        for (k, line) in text.lines().enumerate() {
+            let line = line.split('#').next().unwrap_or("").trim();
+            if line.is_empty() {
+                continue;
+            }
+            let err = |reason: String| SceneError::HintLine {
+                path: path.to_path_buf(),
+                line: k + 1,
+                reason,
+            };
+            let parts: Vec<&str> = line.split_whitespace().collect();
+            if parts.len() != 6 && parts.len() != 7 {
+                return Err(err(format!(
+                    "expected `occluder x y z px py [weight]`, got {} fields",
+                    parts.len()
+                )));
+            }
+            let mut nums = [0.0f64; 6];
+            for (n, s) in parts[1..].iter().enumerate() {
+                let x: f64 = s
+                    .parse()
+                    .map_err(|_| err(format!("`{s}` is not a number")))?;
+                if !x.is_finite() {
+                    return Err(err(format!("`{s}` is not a finite number")));
+                }
+                nums[n] = x;
+            }
+            let raw = RawHint {
+                occluder: parts[0].to_string(),
+                point: [nums[0], nums[1], nums[2]],
+                pixel: [nums[3], nums[4]],
+                weight: if parts.len() == 7 {
+                    Some(nums[5])
+                } else {
+                    None
+                },
+            };
+            let h = self
+                .hint(&format!("hints (line {})", k + 1), &raw, occ)
+                .map_err(|e| err(e.to_string()))?;
+            out.push(h);
+        }
+        Ok(out)
+    }
+
+    fn stage(
+        &self,
+        field: &str,
+        rs: &RawStage,
+        default_name: String,
+        default_vary: &[usize],
+        occ: &[Occluder],
+    ) -> Result<Stage> {
+        let mut w = [0.0; TERM_COUNT];
+        for (key, value) in &rs.weights {
+            let term = Term::from_key(key).ok_or_else(|| {
+                self.field_err(
+                    format!("{field}.weights.{key}"),
+                    format!(
+                        "unknown energy term; use one of {}",
+                        Term::ALL.map(|t| t.key()).join(", ")
+                    ),
+                )
+            })?;
+            w[term as usize] = self.non_negative(&format!("{field}.weights.{key}"), *value)?;
+        }
+        let vary = match &rs.vary {
+            None => default_vary.to_vec(),
+            Some(RawVary::All(s)) if s == "all" => occ
+                .iter()
+                .enumerate()
+                .filter(|(_, o)| o.launched)
+                .map(|(i, _)| i)
+                .collect(),
+            Some(RawVary::All(s)) => {
+                return Err(self.field_err(
+                    format!("{field}.vary"),
+                    format!("must be \"all\" or a list of occluder names, got \"{s}\""),
+                ))
+            }
+            Some(RawVary::Names(names)) => {
+                let mut out = Vec::new();
+                for n in names {
+                    let i = occ.iter().position(|o| &o.name == n).ok_or_else(|| {
+                        self.field_err(
+                            format!("{field}.vary"),
+                            format!("names occluder `{n}`, which does not exist"),
+                        )
+                    })?;
+                    if !occ[i].launched {
+                        return Err(self.field_err(
+                            format!("{field}.vary"),
+                            format!("occluder `{n}` is not launched and cannot vary"),
+                        ));
+                    }
+                    if !out.contains(&i) {
+                        out.push(i);
+                    }
+                }
+                out
+            }
+        };
+        if vary.is_empty() {
+            return Err(self.field_err(format!("{field}.vary"), "no occluder varies in this stage"));
+        }
+        let n = 6 * vary.len();
+        let step = self.positive(&format!("{field}.step"), rs.step.unwrap_or(0.3))?;
+        let max_iterations = rs.max_iterations.unwrap_or(150);
+        if max_iterations == 0 {
+            return Err(self.field_err(format!("{field}.max_iterations"), "must be at least 1"));
+        }
+        let population = rs
+            .population
+            .unwrap_or(4 + (3.0 * (n as f64).ln()).floor() as usize);
+        if !(4..=MAX_POPULATION).contains(&population) {
+            return Err(self.field_err(
+                format!("{field}.population"),
+                format!("must be between 4 and {MAX_POPULATION}"),
+            ));
+        }
+        let target_energy = match rs.target_energy {
+            Some(x) => Some(self.finite(&format!("{field}.target_energy"), x)?),
+            None => None,
+        };
+        let tol_fun = self.non_negative(&format!("{field}.tol_fun"), rs.tol_fun.unwrap_or(1e-9))?;
+        let stagnation = rs.stagnation.unwrap_or(60);
+        if stagnation == 0 {
+            return Err(self.field_err(
+                format!("{field}.stagnation"),
+                "must be at least 1 iteration",
+            ));
+        }
+        Ok(Stage {
+            name: rs.name.clone().unwrap_or(default_name),
+            weights: Weights(w),
+            vary,
+            step,
+            max_iterations,
+            population,
+            target_energy,
+            tol_fun,
+            stagnation,
+        })
+    }
+
+    fn stages(&self, raw: &RawScene, occ: &[Occluder]) -> Result<(Vec<Stage>, Strategy)> {
+        let launched: Vec<usize> = occ
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| o.launched)
+            .map(|(i, _)| i)
+            .collect();
+        match (&raw.strategy, &raw.stages) {
+            (None | Some(RawStrategy::Scheduled), Some(list)) => {
+                if list.is_empty() {
+                    return Err(self.field_err("stages", "needs at least one stage"));
+                }
+                let stages = list
+                    .iter()
+                    .enumerate()
+                    .map(|(i, s)| self.stage(&format!("stages[{i}]"), s, format!("stage {}", i + 1), &launched, occ))
+                    .collect::<Result<Vec<_>>>()?;
+                Ok((stages, Strategy::Scheduled))
+            }
+            (None | Some(RawStrategy::Scheduled), None) => Err(self.field_err(
+                "stages",
+                "is required with the scheduled strategy (or give `strategy` of kind \"sequential\")",
+            )),
+            (Some(RawStrategy::Sequential { .. }), Some(_)) => Err(self.field_err(
+                "stages",
+                "the sequential strategy builds its own stages from `strategy.stage` and `strategy.final`; remove `stages`",
+            )),
+            (Some(RawStrategy::Sequential { order, rounds, stage, final_stage }), None) => {
+                let rounds = match rounds.as_ref() {
+                    None => 1,
+                    Some(&r) if (1..=100).contains(&r) => r as usize,
+                    Some(r) => {
+                        return Err(self.field_err("strategy.rounds", format!("must be 1 to 100, got {r}")))
+                    }
+                };
+                let order: Vec<usize> = match order {
+                    None => auto_order(occ),
+                    Some(RawOrder::Auto(s)) if s == "auto" => auto_order(occ),
+                    Some(RawOrder::Auto(s)) => {
+                        return Err(self.field_err("strategy.order", format!("must be \"auto\" or a list of occluder names, got \"{s}\"")))
+                    }
+                    Some(RawOrder::Names(names)) => {
+                        let mut out = Vec::new();
+                        for n in names {
+                            let i = occ.iter().position(|o| &o.name == n).ok_or_else(|| {
+                                self.field_err("strategy.order", format!("names occluder `{n}`, which does not exist"))
+                            })?;
+                            if !occ[i].launched {
+                                return Err(self.field_err("strategy.order", format!("occluder `{n}` is not launched")));
+                            }
+                            if out.contains(&i) {
+                                return Err(self.field_err("strategy.order", format!("occluder `{n}` is listed twice")));
+                            }
+                            out.push(i);
+                        }
+                        out
+                    }
+                };
+                if stage.vary.is_some() {
+                    return Err(self.field_err("strategy.stage.vary", "is set by the sequential strategy (one occluder per stage); remove it"));
+                }
+                let mut stages = Vec::new();
+                for round in 1..=rounds {
+                    for &i in &order {
+                        // Later rounds are told apart in progress and reports.
+                        let name = if round == 1 {
+                            occ[i].name.clone()
+                        } else {
+                            format!("{} ({round})", occ[i].name)
+                        };
+                        let s = self.stage("strategy.stage", stage, name, &[i], occ)?;
+                        stages.push(s);
+                    }
+                }
+                if let Some(fs) = final_stage {
+                    stages.push(self.stage("strategy.final", fs, "final".to_string(), &launched, occ)?);
+                }
+                Ok((stages, Strategy::Sequential { order }))
+            }
+        }
+    }
+}
