@@ -1,0 +1,400 @@
+//! The Monte Carlo machinery: [`Budget`] (a solution's vacuum launch, poses at `t` and
+//! drag model per body), the seeded per-sample launch errors ([`BodyError`]), the
+//! compensated launch in air and the IoU statistics ([`IouStats`]).
+
+use super::*;
+
+/// The actual errors of one body in one sample (not tolerances): relative speed error,
+/// direction error (rad, two perpendicular components), relative spin error, release
+/// delay (s), relative drag-coefficient error.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BodyError {
+    pub speed: f64,
+    pub direction: [f64; 2],
+    pub spin: f64,
+    pub timing: f64,
+    pub cd: f64,
+}
+
+/// A solution's launch with its drag model.
+pub struct Budget<'a> {
+    pub problem: &'a Problem,
+    pub drag: DragConfig,
+    /// Drag coefficients of every occluder.
+    pub bodies: Vec<BodyDrag>,
+    /// The vacuum launch (6 values per occluder).
+    pub vacuum: Vec<f64>,
+    /// Vacuum pose (origin, orientation) and centre of mass of every occluder at `t`.
+    pub vacuum_pose: Vec<(DVec3, DQuat)>,
+    pub vacuum_com: Vec<DVec3>,
+    /// Landing time in the vacuum solution, if the body lands before `t`.
+    pub landed: Vec<Option<f64>>,
+    /// IoU at `t` in vacuum.
+    pub vacuum_iou: f64,
+}
+
+/// Per-thread buffers of the budget.
+pub struct BudgetWorkspace {
+    pub(super) ws: Workspace,
+    flight: FreeFlight,
+}
+
+/// Rotate `v` by the direction error `d` (rad) about two axes perpendicular to it: the
+/// horizontal one (`v x z`, or `v x x` for a vertical `v`) and the one completing it.
+pub(super) fn aim(v: DVec3, d: [f64; 2]) -> DVec3 {
+    if d == [0.0, 0.0] {
+        return v;
+    }
+    let u = v.normalize_or_zero();
+    if u == DVec3::ZERO {
+        return v;
+    }
+    let mut e1 = u.cross(DVec3::Z);
+    if e1.length_squared() < 1e-12 {
+        e1 = u.cross(DVec3::X);
+    }
+    let e1 = e1.normalize();
+    let e2 = u.cross(e1);
+    DQuat::from_scaled_axis(e1 * d[0] + e2 * d[1]) * v
+}
+
+/// SplitMix64 of `(seed, k)`: the seed of sample `k`'s generator.
+pub(super) fn sample_seed(seed: u64, k: u64) -> u64 {
+    let mut z = seed
+        .wrapping_mul(0xD1B5_4A32_D192_ED03)
+        .wrapping_add(0x9E37_79B9_7F4A_7C15u64.wrapping_mul(k.wrapping_add(1)));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// The errors of sample `k`: six standard normals per body, always drawn in the same
+/// order (so that every tolerance size sees the same draws), scaled by the tolerances.
+pub(super) fn draw_errors(seed: u64, k: u64, tol: &Tolerances, out: &mut [BodyError]) {
+    let mut rng = ChaCha8Rng::seed_from_u64(sample_seed(seed, k));
+    for e in out.iter_mut() {
+        let mut z = [0.0f64; 6];
+        for zi in &mut z {
+            *zi = StandardNormal.sample(&mut rng);
+        }
+        *e = BodyError {
+            speed: z[0] * tol.speed_pct / 100.0,
+            direction: [
+                (z[1] * tol.direction_deg).to_radians(),
+                (z[2] * tol.direction_deg).to_radians(),
+            ],
+            spin: z[3] * tol.spin_pct / 100.0,
+            timing: z[4] * tol.timing_ms / 1000.0,
+            cd: z[5] * tol.cd_pct / 100.0,
+        };
+    }
+}
+
+/// Statistics of a set of IoUs.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct IouStats {
+    pub samples: usize,
+    pub mean: f64,
+    /// 5th percentile (linear interpolation between order statistics).
+    pub p5: f64,
+    pub median: f64,
+    pub min: f64,
+    pub max: f64,
+    /// Fraction of samples with IoU >= the threshold ([`BudgetReport::iou_threshold`]).
+    pub p_iou_at_least_threshold: f64,
+    /// Samples whose flight diverged (counted with IoU 0).
+    pub diverged: usize,
+}
+
+pub(super) fn quantile(sorted: &[f64], p: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let h = (sorted.len() - 1) as f64 * p;
+    let i = h.floor() as usize;
+    let j = (i + 1).min(sorted.len() - 1);
+    sorted[i] + (h - i as f64) * (sorted[j] - sorted[i])
+}
+
+impl IouStats {
+    /// Statistics of `ious`, counting those `>= threshold` as successes.
+    pub fn new(ious: &[f64], diverged: usize, threshold: f64) -> IouStats {
+        let mut s = ious.to_vec();
+        s.sort_by(f64::total_cmp);
+        let n = s.len().max(1) as f64;
+        IouStats {
+            samples: ious.len(),
+            mean: ious.iter().sum::<f64>() / n,
+            p5: quantile(&s, 0.05),
+            median: quantile(&s, 0.5),
+            min: s.first().copied().unwrap_or(f64::NAN),
+            max: s.last().copied().unwrap_or(f64::NAN),
+            p_iou_at_least_threshold: ious.iter().filter(|&&x| x >= threshold).count() as f64 / n,
+            diverged,
+        }
+    }
+}
+
+/// A progress sink for the long phases (the CLI draws a bar; `()` ignores it).
+pub trait Progress: Sync {
+    fn start(&self, _phase: &str, _total: u64) {}
+    fn advance(&self, _n: u64) {}
+    fn finish(&self) {}
+}
+impl Progress for () {}
+
+impl<'a> Budget<'a> {
+    /// The budget of launch values `params` (6 per occluder) in `problem`.
+    pub fn new(
+        problem: &'a Problem,
+        params: &[f64],
+        drag: DragConfig,
+    ) -> Result<Budget<'a>, BudgetError> {
+        drag.validate()?;
+        let scene = &problem.scene;
+        if params.len() != scene.variable_count() {
+            return Err(BudgetError::Parameters {
+                expected: scene.variable_count(),
+                found: params.len(),
+            });
+        }
+        let bodies = scene
+            .occluders
+            .iter()
+            .map(|o| BodyDrag::new(&o.shape, o.mass.mass, &drag))
+            .collect();
+        let mut ws = problem.workspace();
+        problem.fly(params, &mut ws);
+        let n = scene.occluders.len();
+        let vacuum_pose = ws.poses.clone();
+        let vacuum_com = (0..n)
+            .map(|i| vacuum_pose[i].0 + vacuum_pose[i].1 * scene.occluders[i].mass.local_com)
+            .collect();
+        let landed = (0..n).map(|i| ws.landing_time(i)).collect();
+        problem.shadow(&mut ws);
+        let vacuum_iou = energy::iou(&ws.mask, &problem.target.mask);
+        Ok(Budget {
+            problem,
+            drag,
+            bodies,
+            vacuum: params.to_vec(),
+            vacuum_pose,
+            vacuum_com,
+            landed,
+            vacuum_iou,
+        })
+    }
+
+    pub fn workspace(&self) -> BudgetWorkspace {
+        BudgetWorkspace {
+            ws: self.problem.workspace(),
+            flight: FreeFlight::default(),
+        }
+    }
+
+    /// Centre of mass at `t` of occluder `i` launched with `v`, `w` through air, with
+    /// errors `e`; its orientation at `t` too when `flight` is given.
+    fn pose(
+        &self,
+        i: usize,
+        v: DVec3,
+        w: DVec3,
+        e: &BodyError,
+        flight: Option<&mut FreeFlight>,
+    ) -> (DVec3, DQuat) {
+        let scene = &self.problem.scene;
+        let o = &scene.occluders[i];
+        let v = aim(v, e.direction) * (1.0 + e.speed);
+        let w = w * (1.0 + e.spin);
+        let tau = scene.t - e.timing;
+        if !(v.is_finite() && w.is_finite()) || w.length() * scene.t > MAX_TURN {
+            return (DVec3::NAN, DQuat::NAN);
+        }
+        let body = if e.cd != 0.0 {
+            self.bodies[i].with_cd_factor(1.0 + e.cd)
+        } else {
+            self.bodies[i]
+        };
+        let (com, _) = drag::fly(
+            &body,
+            o.launch_com(),
+            v,
+            w,
+            scene.gravity,
+            tau,
+            self.drag.max_step,
+        );
+        let q = match flight {
+            Some(f) => {
+                f.reset(
+                    &o.mass,
+                    o.position,
+                    o.orientation,
+                    v,
+                    w,
+                    scene.gravity,
+                    tau.max(scene.t),
+                    &self.problem.flight,
+                );
+                f.orientation(tau)
+            }
+            None => DQuat::IDENTITY,
+        };
+        (com, q)
+    }
+
+    /// Drag poses at `t` of every occluder for launch `params` with errors `errors`
+    /// (one per occluder) into the workspace, then the shadow and its IoU. Returns
+    /// `(IoU, diverged)`; a diverged flight has IoU 0.
+    pub fn iou(
+        &self,
+        params: &[f64],
+        errors: &[BodyError],
+        bws: &mut BudgetWorkspace,
+    ) -> (f64, bool) {
+        let scene = &self.problem.scene;
+        for (i, o) in scene.occluders.iter().enumerate() {
+            if !o.launched {
+                bws.ws.poses[i] = (o.position, o.orientation);
+                continue;
+            }
+            let (v, w) = launch_velocities(params, i);
+            let (com, q) = self.pose(i, v, w, &errors[i], Some(&mut bws.flight));
+            if !(com.is_finite() && q.is_finite()) {
+                return (0.0, true);
+            }
+            bws.ws.poses[i] = (com - q * o.mass.local_com, q);
+        }
+        self.problem.shadow(&mut bws.ws);
+        (energy::iou(&bws.ws.mask, &self.problem.target.mask), false)
+    }
+
+    /// Centre of mass with drag at `t` of occluder `i` for launch `params`.
+    pub fn drag_com(&self, params: &[f64], i: usize, e: &BodyError) -> DVec3 {
+        let o = &self.problem.scene.occluders[i];
+        if !o.launched {
+            return o.launch_com();
+        }
+        let (v, w) = launch_velocities(params, i);
+        self.pose(i, v, w, e, None).0
+    }
+
+    /// Orientation with drag at `t` of occluder `i` (drag exerts no torque in the model).
+    pub fn drag_orientation(&self, params: &[f64], i: usize) -> DQuat {
+        let o = &self.problem.scene.occluders[i];
+        if !o.launched {
+            return o.orientation;
+        }
+        let (v, w) = launch_velocities(params, i);
+        let mut f = FreeFlight::default();
+        self.pose(i, v, w, &BodyError::default(), Some(&mut f)).1
+    }
+
+    /// Launch velocity of occluder `i` that brings its centre of mass with drag to its
+    /// vacuum position at `t`: Newton on the 3 velocity components with a central
+    /// finite-difference Jacobian and step halving. Returns (velocity, iterations,
+    /// residual in m).
+    pub fn compensate_body(&self, i: usize) -> (DVec3, usize, f64) {
+        let scene = &self.problem.scene;
+        let o = &scene.occluders[i];
+        let (v_vac, w) = launch_velocities(&self.vacuum, i);
+        if !o.launched {
+            return (DVec3::ZERO, 0, 0.0);
+        }
+        let target = self.vacuum_com[i];
+        let e = BodyError::default();
+        let f = |v: DVec3| self.pose(i, v, w, &e, None).0 - target;
+        let mut v = v_vac;
+        let mut r = f(v);
+        // A first guess: make up the shortfall evenly over the flight.
+        let guess = v - r / scene.t;
+        let rg = f(guess);
+        if rg.length() < r.length() {
+            v = guess;
+            r = rg;
+        }
+        let mut it = 0;
+        while it < MAX_NEWTON && r.length() > NEWTON_TOL && r.is_finite() {
+            it += 1;
+            let h = 1e-6 * (1.0 + v.length());
+            let mut cols = [DVec3::ZERO; 3];
+            for (j, c) in cols.iter_mut().enumerate() {
+                let mut d = DVec3::ZERO;
+                d[j] = h;
+                *c = (f(v + d) - f(v - d)) / (2.0 * h);
+            }
+            let jac = DMat3::from_cols(cols[0], cols[1], cols[2]);
+            let dv = -(jac.inverse() * r);
+            if !dv.is_finite() {
+                break;
+            }
+            let mut lambda = 1.0;
+            let mut improved = false;
+            while lambda > 1e-6 {
+                let vn = v + dv * lambda;
+                let rn = f(vn);
+                if rn.length() < r.length() {
+                    v = vn;
+                    r = rn;
+                    improved = true;
+                    break;
+                }
+                lambda *= 0.5;
+            }
+            if !improved {
+                break;
+            }
+        }
+        (v, it, r.length())
+    }
+
+    /// The compensated launch (6 values per occluder; spins unchanged), with per-body
+    /// Newton iterations and residuals.
+    pub fn compensate(&self) -> (Vec<f64>, Vec<(usize, f64)>) {
+        let mut params = self.vacuum.clone();
+        let mut info = Vec::new();
+        for i in 0..self.problem.scene.occluders.len() {
+            let (v, it, res) = self.compensate_body(i);
+            if self.problem.scene.occluders[i].launched {
+                params[6 * i..6 * i + 3].copy_from_slice(&v.to_array());
+            }
+            info.push((it, res));
+        }
+        (params, info)
+    }
+
+    /// IoUs of `n` Monte Carlo samples of launch `params` at tolerances `tol`, in sample
+    /// order, with the diverged count.
+    pub fn monte_carlo(
+        &self,
+        params: &[f64],
+        tol: &Tolerances,
+        n: usize,
+        seed: u64,
+        pool: &rayon::ThreadPool,
+        progress: &dyn Progress,
+    ) -> (Vec<f64>, usize) {
+        let nb = self.problem.scene.occluders.len();
+        let done = AtomicU64::new(0);
+        let out: Vec<(f64, bool)> = pool.install(|| {
+            (0..n)
+                .into_par_iter()
+                .map_init(
+                    || (self.workspace(), vec![BodyError::default(); nb]),
+                    |(bws, errs), k| {
+                        draw_errors(seed, k as u64, tol, errs);
+                        let r = self.iou(params, errs, bws);
+                        let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                        if d.is_multiple_of(64) {
+                            progress.advance(64);
+                        }
+                        r
+                    },
+                )
+                .collect()
+        });
+        progress.advance(n as u64 % 64);
+        let diverged = out.iter().filter(|r| r.1).count();
+        (out.into_iter().map(|r| r.0).collect(), diverged)
+    }
+}

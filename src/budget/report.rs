@@ -1,0 +1,351 @@
+//! What `budget.json` holds ([`BudgetReport`] and its parts) and its Markdown rendering
+//! (`budget.md`).
+
+use super::*;
+
+/// Everything `budget.json` holds.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BudgetReport {
+    pub scene: String,
+    pub t_s: f64,
+    pub seed: u64,
+    pub drag: DragConfig,
+    pub tolerances: Tolerances,
+    /// The IoU a sample must reach ([`BudgetOptions::iou_threshold`]).
+    pub iou_threshold: f64,
+    pub probability_target: f64,
+    /// Set when the exact compensated launch is already below the threshold (no launcher
+    /// precision can reach it; the tolerance search is skipped); `null` otherwise.
+    pub threshold_unreachable: Option<Unreachable>,
+    pub iou_vacuum: f64,
+    /// The vacuum launch flown through air.
+    pub iou_drag_uncompensated: f64,
+    /// The compensated launch flown through air.
+    pub iou_drag_compensated: f64,
+    pub occluders: Vec<OccluderReport>,
+    /// Monte Carlo of the compensated launch in air at the requested tolerances.
+    pub monte_carlo: IouStats,
+    pub histogram: Histogram,
+    pub sensitivity: Vec<Sensitivity>,
+    pub search: Option<ToleranceSearch>,
+    pub notes: Vec<String>,
+}
+
+/// Drag figures of one occluder.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct OccluderReport {
+    pub name: String,
+    pub shape: String,
+    pub launched: bool,
+    pub mass_kg: f64,
+    pub cd: f64,
+    pub reference_area_m2: f64,
+    /// `k = rho Cd A / (2 m)` (1/m).
+    pub drag_k_per_m: f64,
+    pub terminal_speed_m_s: f64,
+    pub vacuum_com_at_t_m: [f64; 3],
+    /// The vacuum launch flown through air.
+    pub drag_com_at_t_m: [f64; 3],
+    pub position_error_m: f64,
+    /// Angle between the vacuum and drag orientations at `t`: 0 by construction (drag
+    /// torque is neglected).
+    pub orientation_error_rad: f64,
+    pub vacuum_velocity_m_s: [f64; 3],
+    pub compensated_velocity_m_s: [f64; 3],
+    pub speed_change_pct: f64,
+    /// Distance of the compensated launch's centre of mass at `t` from the vacuum one.
+    pub compensated_com_error_m: f64,
+    pub newton_iterations: usize,
+    /// Landing time in the vacuum solution (the drag model has no contacts).
+    pub lands_before_t_in_vacuum_s: Option<f64>,
+}
+
+/// IoU histogram of the Monte Carlo samples.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Histogram {
+    pub lo: f64,
+    pub hi: f64,
+    pub counts: Vec<usize>,
+}
+
+impl Histogram {
+    pub(super) fn new(values: &[f64], bins: usize) -> Histogram {
+        let min = values.iter().copied().fold(1.0, f64::min);
+        let lo = ((min * 20.0).floor() / 20.0).clamp(0.0, 0.95);
+        let hi = 1.0;
+        let mut counts = vec![0; bins];
+        for &v in values {
+            let b = ((v - lo) / (hi - lo) * bins as f64).floor();
+            let b = (b.max(0.0) as usize).min(bins - 1);
+            counts[b] += 1;
+        }
+        Histogram { lo, hi, counts }
+    }
+}
+
+/// Finite-difference sensitivities of one occluder (the others exact), compensated
+/// launch in air: IoU lost and centre-of-mass shift at `t` per unit error.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Sensitivity {
+    pub name: String,
+    pub iou_lost_per_pct_speed: f64,
+    pub iou_lost_per_deg: f64,
+    pub iou_lost_per_ms: f64,
+    pub iou_lost_per_pct_spin: f64,
+    pub iou_lost_per_pct_cd: f64,
+    pub mm_per_pct_speed: f64,
+    pub mm_per_deg: f64,
+    pub mm_per_ms: f64,
+    pub mm_per_pct_cd: f64,
+}
+
+/// One point of a tolerance curve.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CurvePoint {
+    pub size: f64,
+    pub mean: f64,
+    pub p5: f64,
+    pub p_iou_at_least_threshold: f64,
+}
+
+/// The largest size of one error alone.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SingleTolerance {
+    pub parameter: String,
+    pub unit: String,
+    /// Largest 1-sigma size keeping P(IoU >= threshold) >= 95 % (the others zero).
+    pub largest: f64,
+    /// True when even the accepted limit keeps it (no limit found within range).
+    pub at_limit: bool,
+    pub curve: Vec<CurvePoint>,
+}
+
+/// The tolerance search.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ToleranceSearch {
+    pub samples_per_evaluation: usize,
+    pub single: Vec<SingleTolerance>,
+    /// Largest common factor on the requested tolerances keeping
+    /// P(IoU >= threshold) >= 95 %.
+    pub joint_scale: f64,
+    pub joint_tolerances: Tolerances,
+    pub joint_at_limit: bool,
+}
+
+/// Why the threshold cannot be reached: even the exact compensated launch is below it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Unreachable {
+    /// Which IoUs are below the threshold: `"vacuum"`, `"compensated"` or both.
+    pub below: Vec<String>,
+    /// A threshold the exact compensated launch does reach (the largest multiple of 0.05
+    /// not above the smaller of the vacuum and compensated IoUs), if any.
+    pub suggested_threshold: Option<f64>,
+    /// The explanation printed by the CLI and written to `budget.md`.
+    pub message: String,
+}
+
+impl Unreachable {
+    /// `None` when the exact compensated launch reaches `threshold`. The vacuum IoU below
+    /// the threshold is reported with it; the search is only impossible when the
+    /// compensated IoU is below (what every zero-tolerance sample flies).
+    pub fn check(iou_vacuum: f64, iou_compensated: f64, threshold: f64) -> Option<Unreachable> {
+        if iou_compensated >= threshold {
+            return None;
+        }
+        let mut below = Vec::new();
+        if iou_vacuum < threshold {
+            below.push("vacuum".to_string());
+        }
+        below.push("compensated".to_string());
+        let reach = iou_vacuum.min(iou_compensated);
+        // Rounded so that 0.85 prints as 0.85, then checked against `reach` exactly.
+        let mut suggestion = ((reach * 20.0).floor() / 20.0 * 100.0).round() / 100.0;
+        if suggestion > reach {
+            suggestion -= 0.05;
+        }
+        let suggested_threshold = (suggestion > 0.0).then_some(suggestion);
+        let what = if iou_vacuum < threshold {
+            format!("the vacuum solution reaches IoU {iou_vacuum:.4} < threshold {threshold}")
+        } else {
+            format!(
+                "the vacuum solution reaches IoU {iou_vacuum:.4} but the drag-compensated launch only {iou_compensated:.4} < threshold {threshold}"
+            )
+        };
+        let message = match suggested_threshold {
+            Some(s) => format!(
+                "{what}: no launcher precision can reach it (P(IoU >= {threshold}) is 0 at any tolerance); rerun with --iou-threshold {s}"
+            ),
+            None => format!("{what}: no launcher precision can reach it"),
+        };
+        Some(Unreachable {
+            below,
+            suggested_threshold,
+            message,
+        })
+    }
+}
+
+/// The result of [`run`].
+pub struct BudgetRun {
+    pub report: BudgetReport,
+    /// The compensated launch (6 values per occluder).
+    pub compensated: Vec<f64>,
+    /// Centre of mass at `t` of the compensated launch with drag.
+    pub compensated_com: Vec<DVec3>,
+    /// IoU of every Monte Carlo sample, in sample order.
+    pub ious: Vec<f64>,
+}
+
+impl BudgetReport {
+    /// The report as Markdown (`budget.md`).
+    pub fn markdown(&self) -> String {
+        use std::fmt::Write;
+        let mut s = String::new();
+        let d = &self.drag;
+        let t = &self.tolerances;
+        let _ = writeln!(s, "# Error budget: `{}`\n", self.scene);
+        let _ = writeln!(
+            s,
+            "Shadow at t = {} s. Air: rho = {} kg/m^3; Cd sphere {}, box {}, mesh {}; Magnus lift {}; RK4 step <= {} s. Seed {}.\n",
+            self.t_s,
+            d.rho,
+            d.cd_sphere,
+            d.cd_box,
+            d.cd_mesh,
+            if d.magnus { "on" } else { "off" },
+            d.max_step,
+            self.seed
+        );
+        let _ = writeln!(s, "## Drag\n");
+        let _ = writeln!(
+            s,
+            "| IoU at t | vacuum | vacuum launch in air | compensated launch in air |\n|---|---|---|---|\n| | {:.4} | {:.4} | {:.4} |\n",
+            self.iou_vacuum, self.iou_drag_uncompensated, self.iou_drag_compensated
+        );
+        if let Some(u) = &self.threshold_unreachable {
+            let _ = writeln!(s, "**Threshold unreachable:** {}.\n", u.message);
+        }
+        let _ = writeln!(s, "| occluder | shape | Cd | A (m^2) | k (1/m) | v_T (m/s) | drag moves it by (mm) | orientation error (rad) | speed change (%) | compensated COM error (mm) | Newton it. |");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
+        for o in &self.occluders {
+            if !o.launched {
+                let _ = writeln!(
+                    s,
+                    "| {} | {} | | | | | stays put | | | | |",
+                    o.name, o.shape
+                );
+                continue;
+            }
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {:.5} | {:.5} | {:.2} | {:.1} | {:.1e} | {:+.3} | {:.2e} | {} |",
+                o.name,
+                o.shape,
+                o.cd,
+                o.reference_area_m2,
+                o.drag_k_per_m,
+                o.terminal_speed_m_s,
+                1000.0 * o.position_error_m,
+                o.orientation_error_rad,
+                o.speed_change_pct,
+                1000.0 * o.compensated_com_error_m,
+                o.newton_iterations
+            );
+        }
+        let _ = writeln!(s, "\nThe compensated launch table is `launch_drag.csv` (same columns as `launch.csv`; the predicted pose at t is the one with drag).\n");
+        let m = &self.monte_carlo;
+        let _ = writeln!(
+            s,
+            "## Monte Carlo ({} samples, compensated launch in air)\n",
+            m.samples
+        );
+        let _ = writeln!(
+            s,
+            "1-sigma errors per body: speed {} %, direction {} deg, spin {} %, release timing {} ms, drag coefficient {} %.\n",
+            t.speed_pct, t.direction_deg, t.spin_pct, t.timing_ms, t.cd_pct
+        );
+        let _ = writeln!(
+            s,
+            "| mean IoU | 5th percentile | median | min | P(IoU >= {}) | diverged |\n|---|---|---|---|---|---|\n| {:.4} | {:.4} | {:.4} | {:.4} | {:.1} % | {} |\n",
+            self.iou_threshold,
+            m.mean,
+            m.p5,
+            m.median,
+            m.min,
+            100.0 * m.p_iou_at_least_threshold,
+            m.diverged
+        );
+        let _ = writeln!(s, "![IoU histogram](budget_hist.png)\n");
+        let _ = writeln!(
+            s,
+            "## Sensitivity (one body at a time, central differences)\n"
+        );
+        let _ = writeln!(s, "| occluder | IoU lost / 1 % speed | / 1 deg | / 1 ms | / 1 % spin | / 1 % Cd | mm / 1 % speed | mm / 1 deg | mm / 1 ms | mm / 1 % Cd |");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
+        for r in &self.sensitivity {
+            let _ = writeln!(
+                s,
+                "| {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.1} | {:.1} | {:.1} | {:.1} |",
+                r.name,
+                r.iou_lost_per_pct_speed,
+                r.iou_lost_per_deg,
+                r.iou_lost_per_ms,
+                r.iou_lost_per_pct_spin,
+                r.iou_lost_per_pct_cd,
+                r.mm_per_pct_speed,
+                r.mm_per_deg,
+                r.mm_per_ms,
+                r.mm_per_pct_cd
+            );
+        }
+        if let Some(u) = &self.threshold_unreachable {
+            let _ = writeln!(
+                s,
+                "\n## Largest tolerances keeping P(IoU >= {}) >= {} %\n\nUnreachable at any tolerance, so not searched: {}.\n",
+                self.iou_threshold,
+                100.0 * self.probability_target,
+                u.message
+            );
+        }
+        if let Some(se) = &self.search {
+            let _ = writeln!(
+                s,
+                "\n## Largest tolerances keeping P(IoU >= {}) >= {} %\n\n{} samples per evaluation (the same draws at every size).\n",
+                self.iou_threshold,
+                100.0 * self.probability_target,
+                se.samples_per_evaluation
+            );
+            let _ = writeln!(s, "| error | alone (others exact) |\n|---|---|");
+            for p in &se.single {
+                let _ = writeln!(
+                    s,
+                    "| {} | {}{:.4} {} |",
+                    p.parameter,
+                    if p.at_limit { ">= " } else { "" },
+                    p.largest,
+                    p.unit
+                );
+            }
+            let j = &se.joint_tolerances;
+            let _ = writeln!(
+                s,
+                "\nAll together, the requested tolerances scaled by {}{:.4}: speed {:.4} %, direction {:.4} deg, spin {:.4} %, timing {:.4} ms, Cd {:.4} %.\n",
+                if se.joint_at_limit { ">= " } else { "" },
+                se.joint_scale,
+                j.speed_pct,
+                j.direction_deg,
+                j.spin_pct,
+                j.timing_ms,
+                j.cd_pct
+            );
+            let _ = writeln!(s, "![IoU against each tolerance](budget_tolerances.png)\n");
+        }
+        if !self.notes.is_empty() {
+            let _ = writeln!(s, "## Notes\n");
+            for n in &self.notes {
+                let _ = writeln!(s, "- {n}");
+            }
+        }
+        s
+    }
+}
