@@ -118,6 +118,18 @@ impl Term {
 pub struct Weights(pub [f64; TERM_COUNT]);
 
 impl Weights {
+    /// Each raw term times its weight, for reports: a term with weight 0 counts 0, since
+    /// a skipped term may hold NaN from a diverged sample. (The optimizer's total is
+    /// [`weighted_total`], which instead turns any non-finite sum into
+    /// [`DIVERGED_ENERGY`] so that such a sample ranks last.)
+    pub fn weigh(&self, raw: &[f64; TERM_COUNT]) -> [f64; TERM_COUNT] {
+        let mut out = [0.0; TERM_COUNT];
+        for ((o, r), w) in out.iter_mut().zip(raw).zip(&self.0) {
+            *o = if *w == 0.0 { 0.0 } else { r * w };
+        }
+        out
+    }
+
     pub fn get(&self, t: Term) -> f64 {
         self.0[t as usize]
     }

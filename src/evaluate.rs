@@ -26,7 +26,7 @@ use glam::{DQuat, DVec3};
 use crate::energy::{self, TargetData, Term, Weights, DIVERGED_ENERGY, REG_ALPHA, TERM_COUNT};
 use crate::geometry::distance::{table_shape, ContactShape};
 use crate::geometry::shape::Shape;
-use crate::scene::Scene;
+use crate::scene::{Launch, Scene};
 use crate::shadow::mask::Mask;
 use crate::shadow::raster::{MeshSilhouette, RasterScratch};
 use crate::sim::contact::{self, Body, Motion};
@@ -113,19 +113,8 @@ impl Evaluation {
 
     /// Weighted value of each term.
     pub fn weighted(&self, w: &Weights) -> [f64; TERM_COUNT] {
-        let mut out = [0.0; TERM_COUNT];
-        for ((o, r), w) in out.iter_mut().zip(&self.raw).zip(&w.0) {
-            // A skipped term (weight 0) may hold NaN from a diverged sample; it weighs nothing.
-            *o = if *w == 0.0 { 0.0 } else { r * w };
-        }
-        out
+        w.weigh(&self.raw)
     }
-}
-
-/// Launch velocities of one occluder, read from a parameter vector.
-pub fn launch_velocities(params: &[f64], i: usize) -> (DVec3, DVec3) {
-    let p = &params[6 * i..6 * i + 6];
-    (DVec3::new(p[0], p[1], p[2]), DVec3::new(p[3], p[4], p[5]))
 }
 
 impl Problem {
@@ -215,7 +204,7 @@ impl Problem {
     /// launch does, and the asymmetric-body integrator's step grid grows with the turn.
     fn spins_too_fast(&self, params: &[f64]) -> bool {
         self.scene.occluders.iter().enumerate().any(|(i, o)| {
-            o.launched && launch_velocities(params, i).1.length() * self.scene.t > MAX_TURN
+            o.launched && Launch::get(params, i).angular_velocity.length() * self.scene.t > MAX_TURN
         })
     }
 
@@ -224,7 +213,10 @@ impl Problem {
         let scene = &self.scene;
         for (i, o) in scene.occluders.iter().enumerate() {
             if o.launched {
-                let (v, w) = launch_velocities(params, i);
+                let Launch {
+                    velocity: v,
+                    angular_velocity: w,
+                } = Launch::get(params, i);
                 ws.flights[i].reset(
                     &o.mass,
                     o.position,
@@ -432,7 +424,10 @@ impl Problem {
         let mut reg = 0.0;
         for (i, o) in scene.occluders.iter().enumerate() {
             if o.launched {
-                let (v, w) = launch_velocities(params, i);
+                let Launch {
+                    velocity: v,
+                    angular_velocity: w,
+                } = Launch::get(params, i);
                 reg += REG_ALPHA * v.length() + (1.0 - REG_ALPHA) * w.length();
             }
         }
@@ -498,7 +493,7 @@ impl Problem {
     pub fn expand(&self, base: &[f64], vary: &[usize], x: &[f64], out: &mut [f64]) {
         out.copy_from_slice(base);
         for (k, &i) in vary.iter().enumerate() {
-            out[6 * i..6 * i + 6].copy_from_slice(&x[6 * k..6 * k + 6]);
+            Launch::copy(x, k, out, i);
         }
     }
 

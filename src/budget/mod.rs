@@ -42,9 +42,10 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::energy::{self, Weights};
-use crate::evaluate::{launch_velocities, Problem, Workspace, MAX_TURN};
+use crate::evaluate::{Problem, Workspace, MAX_TURN};
 use crate::geometry::shape::Shape;
 use crate::output::solution::{check_solution, MismatchError, Solution};
+use crate::scene::Launch;
 use crate::sim::drag::{self, BodyDrag, DragConfig, DragError};
 use crate::sim::flight::FreeFlight;
 
@@ -314,8 +315,12 @@ pub fn run(
             let bd = &b.bodies[i];
             let drag_com = b.drag_com(params, i, &exact[i]);
             let q_drag = b.drag_orientation(params, i);
-            let (v_vac, _) = launch_velocities(params, i);
-            let (v_comp, _) = launch_velocities(&comp, i);
+            let Launch {
+                velocity: v_vac, ..
+            } = Launch::get(params, i);
+            let Launch {
+                velocity: v_comp, ..
+            } = Launch::get(&comp, i);
             OccluderReport {
                 name: o.name.clone(),
                 shape: shape_name(&o.shape),

@@ -258,7 +258,10 @@ impl<'a> Budget<'a> {
                 bws.ws.poses[i] = (o.position, o.orientation);
                 continue;
             }
-            let (v, w) = launch_velocities(params, i);
+            let Launch {
+                velocity: v,
+                angular_velocity: w,
+            } = Launch::get(params, i);
             let (com, q) = self.pose(i, v, w, &errors[i], Some(&mut bws.flight));
             if !(com.is_finite() && q.is_finite()) {
                 return (0.0, true);
@@ -275,7 +278,10 @@ impl<'a> Budget<'a> {
         if !o.launched {
             return o.launch_com();
         }
-        let (v, w) = launch_velocities(params, i);
+        let Launch {
+            velocity: v,
+            angular_velocity: w,
+        } = Launch::get(params, i);
         self.pose(i, v, w, e, None).0
     }
 
@@ -285,7 +291,10 @@ impl<'a> Budget<'a> {
         if !o.launched {
             return o.orientation;
         }
-        let (v, w) = launch_velocities(params, i);
+        let Launch {
+            velocity: v,
+            angular_velocity: w,
+        } = Launch::get(params, i);
         let mut f = FreeFlight::default();
         self.pose(i, v, w, &BodyError::default(), Some(&mut f)).1
     }
@@ -297,7 +306,10 @@ impl<'a> Budget<'a> {
     pub fn compensate_body(&self, i: usize) -> (DVec3, usize, f64) {
         let scene = &self.problem.scene;
         let o = &scene.occluders[i];
-        let (v_vac, w) = launch_velocities(&self.vacuum, i);
+        let Launch {
+            velocity: v_vac,
+            angular_velocity: w,
+        } = Launch::get(&self.vacuum, i);
         if !o.launched {
             return (DVec3::ZERO, 0, 0.0);
         }
@@ -356,7 +368,11 @@ impl<'a> Budget<'a> {
         for i in 0..self.problem.scene.occluders.len() {
             let (v, it, res) = self.compensate_body(i);
             if self.problem.scene.occluders[i].launched {
-                params[6 * i..6 * i + 3].copy_from_slice(&v.to_array());
+                Launch {
+                    velocity: v,
+                    ..Launch::get(&params, i)
+                }
+                .set(&mut params, i);
             }
             info.push((it, res));
         }

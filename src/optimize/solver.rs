@@ -27,10 +27,10 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::energy::{Term, Weights, TERM_COUNT};
-use crate::evaluate::{launch_velocities, Evaluation, Problem, Workspace};
+use crate::evaluate::{Evaluation, Problem, Workspace};
 use crate::optimize::cmaes::{Cmaes, CmaesConfig, StopReason};
-use crate::output::solution::{Launch, SampleRecord, Solution, StageReport, TermValue};
-use crate::scene::Stage;
+use crate::output::solution::{OccluderLaunch, SampleRecord, Solution, StageReport, TermValue};
+use crate::scene::{Launch, Stage};
 use crate::shadow::mask::Mask;
 
 /// How to run a solve.
@@ -190,10 +190,10 @@ pub fn solve(
         observer.stage_started(k, stage);
         let stage_start = Instant::now();
         let interrupts_at_start = interrupts.load(Ordering::SeqCst);
-        let n = 6 * stage.vary.len();
+        let n = Launch::LEN * stage.vary.len();
         let mut x0 = vec![0.0; n];
         for (j, &i) in stage.vary.iter().enumerate() {
-            x0[6 * j..6 * j + 6].copy_from_slice(&params[6 * i..6 * i + 6]);
+            Launch::copy(&params, i, &mut x0, j);
         }
         let config = CmaesConfig {
             population: Some(stage.population),
@@ -358,25 +358,26 @@ pub fn summarize(
     let mut ws = problem.workspace();
     let all = problem.evaluate(params, &Weights::all_ones(), &mut ws);
     let weights = scene.stages[stages_completed.clamp(1, scene.stages.len()) - 1].weights;
-    let mut energy = std::collections::BTreeMap::new();
-    let mut total = 0.0;
-    for t in Term::ALL {
-        let raw = all.raw[t as usize];
-        let weighted = raw * weights.get(t);
-        total += weighted;
-        energy.insert(t.key().to_string(), TermValue { raw, weighted });
-    }
+    let weighted = weights.weigh(&all.raw);
+    let total: f64 = weighted.iter().sum();
+    let energy = Term::ALL
+        .iter()
+        .map(|&t| {
+            let (raw, weighted) = (all.raw[t as usize], weighted[t as usize]);
+            (t.key().to_string(), TermValue { raw, weighted })
+        })
+        .collect();
     let occluders = scene
         .occluders
         .iter()
         .enumerate()
         .map(|(i, o)| {
-            let (v, w) = launch_velocities(params, i);
-            Launch {
+            let launch = Launch::get(params, i);
+            OccluderLaunch {
                 name: o.name.clone(),
                 launched: o.launched,
-                velocity: v.to_array(),
-                angular_velocity: w.to_array(),
+                velocity: launch.velocity.to_array(),
+                angular_velocity: launch.angular_velocity.to_array(),
             }
         })
         .collect();

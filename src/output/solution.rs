@@ -22,9 +22,9 @@ pub struct SampleRecord {
     pub total: f64,
 }
 
-/// Launch of one occluder.
+/// Launch of one occluder, as `solution.json` holds it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Launch {
+pub struct OccluderLaunch {
     pub name: String,
     pub launched: bool,
     /// Centre-of-mass launch velocity (m/s, world).
@@ -67,7 +67,7 @@ pub struct Solution {
     pub stages_completed: usize,
     /// True when the solve ran every stage to its own stop (not cut short by Ctrl-C).
     pub complete: bool,
-    pub occluders: Vec<Launch>,
+    pub occluders: Vec<OccluderLaunch>,
     /// Every term at the solution, raw and weighted with the last completed stage's weights.
     pub energy: std::collections::BTreeMap<String, TermValue>,
     pub total_energy: f64,

@@ -12,8 +12,9 @@
 use glam::{DQuat, DVec3};
 use serde::Serialize;
 
-use crate::evaluate::{launch_velocities, Problem};
+use crate::evaluate::Problem;
 use crate::geometry::shape::Shape;
+use crate::scene::Launch;
 use crate::sim::continuation::{self, BodyState, ContinuationConfig};
 
 /// Poses at every key: `poses[k][i]` is occluder `i` at `times[k]` (body origin,
@@ -145,10 +146,13 @@ pub fn launch_rows(problem: &Problem, params: &[f64]) -> Vec<LaunchRow> {
         .iter()
         .enumerate()
         .map(|(i, o)| {
-            let (v, w) = if o.launched {
-                launch_velocities(params, i)
+            let Launch {
+                velocity: v,
+                angular_velocity: w,
+            } = if o.launched {
+                Launch::get(params, i)
             } else {
-                (DVec3::ZERO, DVec3::ZERO)
+                Launch::default()
             };
             let com = o.launch_com();
             let speed = v.length();

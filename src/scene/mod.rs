@@ -74,10 +74,12 @@ pub enum SceneError {
 
 type Result<T> = std::result::Result<T, SceneError>;
 
+mod launch;
 mod raw;
 mod start;
 mod validate;
 
+pub use launch::Launch;
 use raw::RawScene;
 use validate::Validator;
 
@@ -196,7 +198,7 @@ pub struct Scene {
 impl Scene {
     /// Number of optimisation variables for all occluders (6 each: v and w).
     pub fn variable_count(&self) -> usize {
-        6 * self.occluders.len()
+        Launch::LEN * self.occluders.len()
     }
 
     /// The initial guess: every occluder's start velocities, laid out as
@@ -204,12 +206,15 @@ impl Scene {
     pub fn start_parameters(&self) -> Vec<f64> {
         let mut p = Vec::with_capacity(self.variable_count());
         for o in &self.occluders {
-            let (v, w) = if o.launched {
-                (o.start_velocity, o.start_angular_velocity)
+            let launch = if o.launched {
+                Launch {
+                    velocity: o.start_velocity,
+                    angular_velocity: o.start_angular_velocity,
+                }
             } else {
-                (DVec3::ZERO, DVec3::ZERO)
+                Launch::default()
             };
-            p.extend_from_slice(&[v.x, v.y, v.z, w.x, w.y, w.z]);
+            p.extend_from_slice(&launch.to_array());
         }
         p
     }

@@ -550,7 +550,7 @@ impl Validator<'_> {
         if vary.is_empty() {
             return Err(self.field_err(format!("{field}.vary"), "no occluder varies in this stage"));
         }
-        let n = 6 * vary.len();
+        let n = Launch::LEN * vary.len();
         let step = self.positive(&format!("{field}.step"), rs.step.unwrap_or(0.3))?;
         let max_iterations = rs.max_iterations.unwrap_or(150);
         if max_iterations == 0 {
