@@ -617,13 +617,7 @@ fn write_exports(dir: &Path, problem: &Problem, solution: &Solution, after: f64)
     let params = solution.parameters();
     let track = crate::output::trajectory::track(problem, &params, after);
     let name = &problem.scene.name;
-    let traj = crate::output::gltf::Trajectory {
-        times: track.times.clone(),
-        poses: track.poses.clone(),
-        t_index: track.t_index,
-        fps: track.fps,
-    };
-    let glb = crate::output::gltf::write_glb(&problem.scene, &traj)
+    let glb = crate::output::gltf::write_glb(&problem.scene, &track)
         .context("cannot build the glTF file")?;
     files::write_atomic(&dir.join(format!("{name}.glb")), &glb)?;
     files::write_csv(

@@ -17,15 +17,18 @@ use crate::geometry::shape::Shape;
 use crate::scene::Launch;
 use crate::sim::continuation::{self, BodyState, ContinuationConfig};
 
-/// Poses at every key: `poses[k][i]` is occluder `i` at `times[k]` (body origin,
-/// body -> world orientation, Z-up world).
+/// The sampled flight of all occluders, one key per simulation step: what the animated
+/// glTF, `trajectory.csv` and Blender show.
 #[derive(Clone, Debug, Default)]
 pub struct Track {
+    /// Key times (s), strictly increasing from 0; contains `t` exactly (at `t_index`).
     pub times: Vec<f64>,
+    /// `poses[k][i]`: occluder `i` at `times[k]` (body origin, body -> world orientation,
+    /// Z-up world).
     pub poses: Vec<Vec<(DVec3, DQuat)>>,
     /// Index of the key at exactly `t`.
     pub t_index: usize,
-    /// 1 / timestep.
+    /// Frames per second the animation is meant for (1 / timestep).
     pub fps: f64,
     /// Keys from `t_index` on come from the rapier continuation.
     pub continuation_from: usize,

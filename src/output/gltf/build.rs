@@ -276,7 +276,7 @@ pub(super) fn shadow_camera(
 /// Perspective camera that shows the whole flight and the receiver: from in front of the
 /// picture's bottom edge, a little to the side, 35 degrees above the horizontal (world Z),
 /// looking at the receiver centre, far enough that everything fits in the vertical fov.
-pub(super) fn view_camera(b: &mut Builder, scene: &Scene, traj: &Trajectory) -> Index<json::Node> {
+pub(super) fn view_camera(b: &mut Builder, scene: &Scene, traj: &Track) -> Index<json::Node> {
     let rc = &scene.receiver;
     let target = rc.center;
     // Content radius about the target: the receiver quad and every body at every key.
@@ -330,7 +330,7 @@ pub(super) fn view_camera(b: &mut Builder, scene: &Scene, traj: &Trajectory) -> 
 /// per occluder, LINEAR, one key per simulation step.
 pub(super) fn flight_animation(
     b: &mut Builder,
-    traj: &Trajectory,
+    traj: &Track,
     nodes: &[Index<json::Node>],
 ) -> Result<(), GltfError> {
     if nodes.is_empty() {

@@ -1,6 +1,6 @@
 //! Animated glTF 2.0 binary (.glb) export of a solved scene, and a reader for checking it.
 //!
-//! Data flow: a validated [`Scene`] plus a sampled [`Trajectory`] (one pose per occluder
+//! Data flow: a validated [`Scene`] plus a sampled [`Track`] (one pose per occluder
 //! per simulation step) go into [`write_glb`], which builds a `gltf::json::Root` and one
 //! binary buffer with a private `Builder` (meshes from [`Shape`]s, materials, the
 //! receiver quad, the table box, a KHR_lights_punctual point light, two cameras and one
@@ -27,6 +27,7 @@ use json::validation::{Checked::Valid, USize64};
 use json::Index;
 
 use crate::geometry::shape::{Shape, TriMesh};
+use crate::output::trajectory::Track;
 use crate::scene::Scene;
 
 mod build;
@@ -62,18 +63,6 @@ const VIEW_YFOV_DEG: f64 = 40.0;
 const VIEW_ASPECT: f64 = 16.0 / 9.0;
 /// Elevation of `camera_view` above the horizontal (degrees).
 const VIEW_ELEVATION_DEG: f64 = 35.0;
-
-/// Sampled flight of all occluders, one key per simulation step.
-#[derive(Clone, Debug)]
-pub struct Trajectory {
-    /// Key times (s), strictly increasing from 0; contains t exactly (at index `t_index`).
-    pub times: Vec<f64>,
-    /// poses[k][i]: occluder i at times[k], (body origin, body->world orientation), Z-up world.
-    pub poses: Vec<Vec<(DVec3, DQuat)>>,
-    pub t_index: usize,
-    /// Frames per second the animation is meant for (1/dt of the scene).
-    pub fps: f64,
-}
 
 /// Why a .glb could not be written or read back.
 #[derive(Debug, thiserror::Error)]
@@ -140,7 +129,7 @@ pub enum GltfError {
 /// a rotation channel with one LINEAR key per entry of `traj.times`; the static transform
 /// of those nodes is the pose at `t`, so that a viewer that ignores animations shows the
 /// picture.
-pub fn write_glb(scene: &Scene, traj: &Trajectory) -> Result<Vec<u8>, GltfError> {
+pub fn write_glb(scene: &Scene, traj: &Track) -> Result<Vec<u8>, GltfError> {
     check_input(scene, traj)?;
     let mut b = Builder::new();
 
@@ -264,7 +253,7 @@ pub fn write_glb(scene: &Scene, traj: &Trajectory) -> Result<Vec<u8>, GltfError>
 // Input checks.
 // ---------------------------------------------------------------------------------
 
-pub(super) fn check_input(scene: &Scene, traj: &Trajectory) -> Result<(), GltfError> {
+pub(super) fn check_input(scene: &Scene, traj: &Track) -> Result<(), GltfError> {
     let keys = traj.times.len();
     if keys == 0 {
         return Err(GltfError::EmptyTrajectory);

@@ -50,7 +50,7 @@ fn shapes_scene() -> Scene {
 
 /// Exact ballistic flight with a steady spin about a fixed axis per body, keyed every
 /// `dt` from 0 to `t + 1 s`, with `times[t_index] = t` exactly.
-fn ballistic(scene: &Scene) -> Trajectory {
+fn ballistic(scene: &Scene) -> Track {
     let dt = scene.dt;
     let n_t = (scene.t / dt).round() as usize;
     let n_end = n_t + (1.0 / dt).round() as usize;
@@ -75,11 +75,12 @@ fn ballistic(scene: &Scene) -> Trajectory {
                 .collect()
         })
         .collect();
-    Trajectory {
+    Track {
         times,
         poses,
         t_index: n_t,
         fps: 1.0 / dt,
+        continuation_from: n_t,
     }
 }
 
