@@ -133,6 +133,7 @@ fn safe_step(d: f64, a: f64, b: f64) -> f64 {
 /// bounds: 5 % low only shortens its steps by 5 %).
 const CA_REL_TOL: f64 = 0.05;
 
+/// First time in `[0, horizon]` at which the two bodies touch, if any. At least one of
 /// them is flying. Bodies may start touching (validation allows up to 0.1 mm of overlap):
 /// then, as for the table, sinking [`TABLE_PENETRATION`] deeper before they have separated,
 /// or touching again after separating, is the contact.
