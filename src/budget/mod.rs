@@ -32,6 +32,7 @@
 //! counted in [`IouStats::diverged`]. Contacts are not modelled with drag; a body that
 //! lands before `t` in the vacuum solution is flagged in the report.
 
+pub mod plots;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{DMat3, DQuat, DVec3};

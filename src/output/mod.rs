@@ -4,6 +4,7 @@
 //! the launch and trajectory tables), [`gltf`] (the animated glTF 2.0 file) and
 //! [`picture`] (overlays and plots for people).
 
+pub mod cycles;
 pub mod files;
 pub mod gltf;
 pub mod picture;

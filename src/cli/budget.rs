@@ -1,0 +1,193 @@
+//! `bsa budget`: the error budget of a saved solution ([`crate::budget`]); writes
+//! `launch_drag.csv`, `budget.json`, `budget.md` and the plots of
+//! [`crate::budget::plots`] next to the solution, and prints a summary.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+
+use crate::budget::{self, plots, BudgetOptions, Tolerances};
+use crate::evaluate::Problem;
+use crate::output::files;
+use crate::sim::drag::DragConfig;
+
+use super::progress::BudgetProgress;
+use super::{load, BudgetArgs};
+
+/// The options of `bsa budget`. The budget's own options are checked by
+/// [`Options::validate`] against the scene, since the largest timing error accepted
+/// depends on the scene's `t`.
+pub(super) struct Options {
+    /// The output folder of a solve, or its `solution.json`.
+    path: PathBuf,
+    scene: Option<PathBuf>,
+    budget: BudgetOptions,
+    quiet: bool,
+}
+
+impl Options {
+    pub(super) fn new(args: BudgetArgs) -> Options {
+        let mut drag = DragConfig {
+            rho: args.rho,
+            magnus: args.magnus,
+            ..Default::default()
+        };
+        if let Some(cd) = args.cd {
+            drag = drag.with_cd(cd);
+        }
+        let budget = BudgetOptions {
+            drag,
+            tolerances: Tolerances {
+                speed_pct: args.speed_tol,
+                direction_deg: args.direction_tol,
+                spin_pct: args.spin_tol,
+                timing_ms: args.timing_tol,
+                cd_pct: args.cd_tol,
+            },
+            samples: args.samples,
+            search_samples: args.search_samples,
+            seed: args.seed,
+            threads: args.threads,
+            iou_threshold: args.iou_threshold,
+        };
+        Options {
+            path: args.path,
+            scene: args.scene,
+            budget,
+            quiet: args.quiet,
+        }
+    }
+
+    /// Check every budget option (drag, tolerances, sample counts, threads, threshold)
+    /// against the scene, before any simulation runs.
+    fn validate(&self, problem: &Problem) -> Result<()> {
+        budget::validate_options(problem, &self.budget).context("invalid budget options")
+    }
+
+    /// The output folder and the solution file of [`Options::path`].
+    fn dir_and_file(&self) -> (PathBuf, PathBuf) {
+        let path = &self.path;
+        if path.is_file() {
+            let dir = path
+                .parent()
+                .filter(|d| !d.as_os_str().is_empty())
+                .unwrap_or(Path::new("."));
+            (dir.to_path_buf(), path.to_path_buf())
+        } else {
+            (path.to_path_buf(), path.join("solution.json"))
+        }
+    }
+}
+
+/// Run the budget, write its files and print a summary.
+pub(super) fn run(opts: &Options) -> Result<()> {
+    let (dir, file) = opts.dir_and_file();
+    let (problem, solution, scene_path) =
+        load::solution_and_scene(&dir, &file, opts.scene.as_deref())?;
+    opts.validate(&problem)?;
+    budget::check_solution_current(&problem, &solution).with_context(|| {
+        format!(
+            "{} does not belong to the scene {} (pass the right one with --scene)",
+            file.display(),
+            scene_path.display()
+        )
+    })?;
+    let bars = BudgetProgress::new(opts.quiet);
+    let start = Instant::now();
+    let run = budget::run(&problem, &solution.parameters(), &opts.budget, &bars)?;
+    let elapsed = start.elapsed().as_secs_f64();
+    let r = &run.report;
+
+    // launch_drag.csv: the launch table of the compensated launch, its pose at t with drag.
+    let mut rows = crate::output::trajectory::launch_rows(&problem, &run.compensated);
+    for (row, com) in rows.iter_mut().zip(&run.compensated_com) {
+        row.com_at_t_x_m = com.x;
+        row.com_at_t_y_m = com.y;
+        row.com_at_t_z_m = com.z;
+    }
+    files::write_csv(&dir.join("launch_drag.csv"), &rows)?;
+    files::write_atomic(
+        &dir.join("budget.json"),
+        serde_json::to_string_pretty(r)?.as_bytes(),
+    )?;
+    let mut md = r.markdown();
+    md.push_str(&format!(
+        "\nMade by `bsa budget` in {elapsed:.2} s on {} threads.\n",
+        opts.budget.threads.unwrap_or_else(|| {
+            std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1)
+        })
+    ));
+    files::write_atomic(&dir.join("budget.md"), md.as_bytes())?;
+    files::save_png(&plots::histogram(r), &dir.join("budget_hist.png"))?;
+    let tolerances_png = dir.join("budget_tolerances.png");
+    match plots::tolerances(r) {
+        Some(img) => files::save_png(&img, &tolerances_png)?,
+        // No search this time: a plot left by an earlier run would not match budget.json.
+        None => {
+            if tolerances_png.is_file() {
+                std::fs::remove_file(&tolerances_png)
+                    .with_context(|| format!("removing the stale {}", tolerances_png.display()))?;
+            }
+        }
+    }
+
+    println!(
+        "{}: IoU at t {:.4} in vacuum, {:.4} with drag, {:.4} with the drag-compensated launch",
+        r.scene, r.iou_vacuum, r.iou_drag_uncompensated, r.iou_drag_compensated
+    );
+    for o in r.occluders.iter().filter(|o| o.launched) {
+        println!(
+            "  {:<12} drag moves it {:>8.1} mm at t; compensated: speed {:+.3} %, COM error {:.2e} mm ({} Newton steps)",
+            o.name,
+            1000.0 * o.position_error_m,
+            o.speed_change_pct,
+            1000.0 * o.compensated_com_error_m,
+            o.newton_iterations
+        );
+    }
+    let m = &r.monte_carlo;
+    let t = &r.tolerances;
+    println!(
+        "  Monte Carlo ({} samples; speed {} %, direction {} deg, spin {} %, timing {} ms, Cd {} %): mean IoU {:.4}, 5th percentile {:.4}, P(IoU >= {}) {:.1} %",
+        m.samples, t.speed_pct, t.direction_deg, t.spin_pct, t.timing_ms, t.cd_pct, m.mean, m.p5, r.iou_threshold, 100.0 * m.p_iou_at_least_threshold
+    );
+    if let Some(u) = &r.threshold_unreachable {
+        println!("  threshold unreachable: {}", u.message);
+        println!("  largest tolerances: none (not searched: no launcher precision reaches the threshold)");
+    }
+    if let Some(se) = &r.search {
+        let alone: Vec<String> = se
+            .single
+            .iter()
+            .map(|p| {
+                format!(
+                    "{} {}{:.3} {}",
+                    p.parameter,
+                    if p.at_limit { ">=" } else { "" },
+                    p.largest,
+                    p.unit
+                )
+            })
+            .collect();
+        println!(
+            "  largest tolerances for P(IoU >= {}) >= {} %: alone {}; together x{:.3} of the requested",
+            r.iou_threshold,
+            100.0 * r.probability_target,
+            alone.join(", "),
+            se.joint_scale
+        );
+    }
+    println!(
+        "wrote {}/{{budget.md, budget.json, launch_drag.csv, budget_hist.png{}}} in {elapsed:.2} s",
+        dir.display(),
+        if r.search.is_some() {
+            ", budget_tolerances.png"
+        } else {
+            ""
+        }
+    );
+    Ok(())
+}

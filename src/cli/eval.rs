@@ -1,0 +1,150 @@
+//! `bsa eval`: print every energy term of a saved solution, raw and weighted by one
+//! stage's weights, as a table or as JSON, optionally with the time of each phase of
+//! one sample.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+
+use crate::energy::{Term, Weights};
+use crate::evaluate::Problem;
+use crate::output::files;
+use crate::output::solution;
+use crate::scene::Scene;
+
+use super::{load, EvalArgs};
+
+/// The validated options of `bsa eval`.
+pub(super) struct Options {
+    scene: PathBuf,
+    solution: PathBuf,
+    /// 1-based; checked against the scene by [`Options::stage`].
+    stage: Option<usize>,
+    json: bool,
+    profile: Option<usize>,
+}
+
+impl Options {
+    /// Nothing can be checked before the scene is loaded: the range of `--stage` is the
+    /// scene's, see [`Options::stage`].
+    pub(super) fn new(args: EvalArgs) -> Options {
+        Options {
+            scene: args.scene,
+            solution: args.solution,
+            stage: args.stage,
+            json: args.json,
+            profile: args.profile,
+        }
+    }
+
+    /// The 1-based stage whose weights to use: `--stage`, checked to be one of the
+    /// scene's, else the last stage.
+    fn stage(&self, scene: &Scene) -> Result<usize> {
+        match self.stage {
+            None => Ok(scene.stages.len()),
+            Some(k) if (1..=scene.stages.len()).contains(&k) => Ok(k),
+            Some(k) => bail!(
+                "--stage {k} is out of range: the scene has stages 1 to {}",
+                scene.stages.len()
+            ),
+        }
+    }
+}
+
+/// Evaluate the solution and print its terms.
+pub(super) fn run(opts: &Options) -> Result<()> {
+    let scene = load::scene(&opts.scene)?;
+    let k = opts.stage(&scene)?;
+    let problem = Problem::new(scene);
+    let solution_path = &opts.solution;
+    let s = files::read_solution(solution_path)?;
+    solution::check_solution(&problem.scene, &s)
+        .with_context(|| format!("{} does not match the scene", solution_path.display()))?;
+    let scene = &problem.scene;
+    let weights = scene.stages[k - 1].weights;
+    let mut ws = problem.workspace();
+    let e = problem.evaluate(&s.parameters(), &Weights::all_ones(), &mut ws);
+    let weighted = weights.weigh(&e.raw);
+    let total: f64 = weighted.iter().sum();
+    let rows: Vec<(Term, f64, f64, f64)> = Term::ALL
+        .iter()
+        .map(|&t| (t, e.raw[t as usize], weights.get(t), weighted[t as usize]))
+        .collect();
+    let first_contact = e.outcome.first_contact.map(|(i, j)| {
+        let a = scene.occluders[i].name.clone();
+        let b = j.map_or_else(|| "table".to_string(), |j| scene.occluders[j].name.clone());
+        (a, b)
+    });
+    let outside: Vec<&str> = problem
+        .shadows_in_image(&ws)
+        .iter()
+        .zip(&scene.occluders)
+        .filter(|(inside, _)| !**inside)
+        .map(|(_, o)| o.name.as_str())
+        .collect();
+    let timings = match opts.profile {
+        Some(reps) => problem.profile(&s.parameters(), reps.max(1), &mut ws),
+        None => Vec::new(),
+    };
+    if opts.json {
+        let terms: serde_json::Map<String, serde_json::Value> = rows
+            .iter()
+            .map(|(t, raw, w, wt)| {
+                (
+                    t.key().to_string(),
+                    serde_json::json!({"raw": raw, "weight": w, "weighted": wt}),
+                )
+            })
+            .collect();
+        let v = serde_json::json!({
+            "scene": scene.name,
+            "stage": k,
+            "terms": terms,
+            "total": total,
+            "iou": e.iou,
+            "t_sim": e.outcome.t_sim,
+            "n_contacts": e.outcome.n_contacts,
+            "first_contact": first_contact.as_ref().map(|(a, b)| [a, b]),
+            "shadows_outside_image": outside,
+            "time_per_phase_us": timings.iter().map(|(k, v)| (k.clone(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        println!(
+            "scene `{}`, weights of stage {} `{}`",
+            scene.name,
+            k,
+            scene.stages[k - 1].name
+        );
+        println!(
+            "{:<16} {:>14} {:>10} {:>14}",
+            "term", "raw", "weight", "weighted"
+        );
+        for (t, raw, w, wt) in &rows {
+            println!("{:<16} {:>14.6} {:>10} {:>14.6}", t.label(), raw, w, wt);
+        }
+        println!("{:<16} {:>14} {:>10} {:>14.6}", "total", "", "", total);
+        println!(
+            "IoU at t {:.5}; t_sim {:.5} s; contacts {}",
+            e.iou, e.outcome.t_sim, e.outcome.n_contacts
+        );
+        if let Some((a, b)) = &first_contact {
+            println!("first contact: `{a}` with `{b}`");
+        }
+        if outside.is_empty() {
+            println!(
+                "every occluder's shadow lies in the image ({} occluders)",
+                scene.occluders.len()
+            );
+        } else {
+            println!("shadows leaving the image: {}", outside.join(", "));
+        }
+        if !timings.is_empty() {
+            println!("time per sample phase (one core, microseconds):");
+            for (k, v) in &timings {
+                println!("  {k:<26} {v:>10.2}");
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,72 @@
+//! `bsa export`: the animated glTF (`<scene>.glb`), `launch.csv` and `trajectory.csv` of
+//! a saved solution. [`write_exports`] is also the last step of `bsa solve`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+
+use crate::evaluate::Problem;
+use crate::output::files;
+use crate::output::solution::Solution;
+
+use super::{load, ExportArgs};
+
+/// The validated options of `bsa export`.
+pub(super) struct Options {
+    dir: PathBuf,
+    scene: Option<PathBuf>,
+    /// Seconds of rapier continuation after `t`: finite and not negative.
+    after: f64,
+}
+
+impl Options {
+    pub(super) fn new(args: ExportArgs) -> Result<Options> {
+        let after = args.after;
+        if !(after.is_finite() && after >= 0.0) {
+            bail!("--after must be a non-negative number of seconds, got {after}");
+        }
+        Ok(Options {
+            dir: args.dir,
+            scene: args.scene,
+            after,
+        })
+    }
+}
+
+/// Load the solution folder and write its exports next to the solution.
+pub(super) fn run(opts: &Options) -> Result<()> {
+    let (problem, solution) = load::solution_dir(&opts.dir, opts.scene.as_deref())?;
+    let msg = write_exports(&opts.dir, &problem, &solution, opts.after)?;
+    println!("{msg}");
+    Ok(())
+}
+
+/// `<scene>.glb`, `launch.csv` and `trajectory.csv`; returns a one-line summary.
+pub(super) fn write_exports(
+    dir: &Path,
+    problem: &Problem,
+    solution: &Solution,
+    after: f64,
+) -> Result<String> {
+    let params = solution.parameters();
+    let track = crate::output::trajectory::track(problem, &params, after);
+    let name = &problem.scene.name;
+    let glb = crate::output::gltf::write_glb(&problem.scene, &track)
+        .context("cannot build the glTF file")?;
+    files::write_atomic(&dir.join(format!("{name}.glb")), &glb)?;
+    files::write_csv(
+        &dir.join("launch.csv"),
+        &crate::output::trajectory::launch_rows(problem, &params),
+    )?;
+    files::write_csv(
+        &dir.join("trajectory.csv"),
+        &crate::output::trajectory::trajectory_rows(problem, &track),
+    )?;
+    Ok(format!(
+        "wrote {}/{{{name}.glb, launch.csv, trajectory.csv}}: {} keys, t = {} s at key {}",
+        dir.display(),
+        track.times.len(),
+        problem.scene.t,
+        track.t_index
+    ))
+}

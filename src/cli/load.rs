@@ -1,0 +1,84 @@
+//! Loading the inputs of the subcommands: a scene, a solve's output folder (its
+//! `solution.json` and the scene it was made for) and the folder's `<scene>.glb`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+
+use crate::evaluate::Problem;
+use crate::output::files;
+use crate::output::solution::{self, Solution};
+use crate::scene::{self, Scene};
+
+/// Load and validate a scene folder or file.
+pub(super) fn scene(path: &Path) -> Result<Scene> {
+    scene::load(path).with_context(|| format!("invalid scene {}", path.display()))
+}
+
+/// Load `DIR/solution.json` and its scene, and check that they belong together.
+pub(super) fn solution_dir(dir: &Path, scene: Option<&Path>) -> Result<(Problem, Solution)> {
+    let file = dir.join("solution.json");
+    let (problem, solution, scene_path) = solution_and_scene(dir, &file, scene)?;
+    solution::check_solution(&problem.scene, &solution).with_context(|| {
+        format!(
+            "{} does not belong to the scene {} (pass the right one with --scene)",
+            file.display(),
+            scene_path.display()
+        )
+    })?;
+    Ok((problem, solution))
+}
+
+/// Read the solution `file` (in the output folder `dir`) and load its scene: `scene` if
+/// given, else the scene file it records, else `scenes/<its scene name>`. Does not check
+/// that they belong together (the callers check in their own ways).
+pub(super) fn solution_and_scene(
+    dir: &Path,
+    file: &Path,
+    scene: Option<&Path>,
+) -> Result<(Problem, Solution, PathBuf)> {
+    if !file.is_file() {
+        bail!(
+            "{} has no solution.json: run `bsa solve <scene> --out {}` first",
+            dir.display(),
+            dir.display()
+        );
+    }
+    let solution = files::read_solution(file)?;
+    let scene_path = match scene {
+        Some(p) => p.to_path_buf(),
+        None => solution
+            .scene_file
+            .as_ref()
+            .map(PathBuf::from)
+            .filter(|p| p.exists())
+            .unwrap_or_else(|| PathBuf::from("scenes").join(&solution.scene)),
+    };
+    let problem = Problem::new(self::scene(&scene_path)?);
+    Ok((problem, solution, scene_path))
+}
+
+/// The `<scene>.glb` of the output folder `dir`, checked to be a glTF file written by
+/// `bsa export` (Blender would otherwise fail on it with a far less helpful message).
+pub(super) fn glb(dir: &Path, problem: &Problem) -> Result<PathBuf> {
+    let glb = dir.join(format!("{}.glb", problem.scene.name));
+    if !glb.is_file() {
+        bail!(
+            "{} does not exist: run `bsa export {}` first",
+            glb.display(),
+            dir.display()
+        );
+    }
+    crate::output::gltf::read_poses_at(
+        &std::fs::read(&glb).with_context(|| format!("cannot read {}", glb.display()))?,
+        0.0,
+    )
+    .with_context(|| {
+        format!(
+            "{} is not a valid glTF file from bsa: run `bsa export {}` again",
+            glb.display(),
+            dir.display()
+        )
+    })?;
+    Ok(glb)
+}

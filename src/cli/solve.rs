@@ -1,0 +1,172 @@
+//! `bsa solve`: optimise the launch velocities of a scene and write the output folder
+//! (solution, pictures, convergence table and plot, and the exports of `bsa export`),
+//! with progress bars, resuming and a two-step Ctrl-C.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use anyhow::{bail, Context, Result};
+
+use crate::energy::Weights;
+use crate::evaluate::Problem;
+use crate::optimize::solver::{self, SolveOptions};
+use crate::output::files;
+use crate::output::solution::{self, Solution};
+
+use super::progress::SolveProgress;
+use super::{export, load, SolveArgs};
+
+/// Ctrl-C presses so far. The solver reads it between iterations: one press ends the
+/// current stage, a second one stops and saves the best so far.
+static INTERRUPTS: AtomicUsize = AtomicUsize::new(0);
+
+/// The most worker threads `--threads` accepts.
+const MAX_THREADS: usize = 1024;
+
+/// The validated options of `bsa solve`.
+pub(super) struct Options {
+    scene: PathBuf,
+    /// `None`: `export/<scene name>`, known once the scene is loaded.
+    out: Option<PathBuf>,
+    seed: Option<u64>,
+    /// Between 1 and [`MAX_THREADS`] when given.
+    threads: Option<usize>,
+    resume: bool,
+    report: bool,
+    quiet: bool,
+}
+
+impl Options {
+    /// Check the arguments that do not depend on the scene.
+    pub(super) fn new(args: SolveArgs) -> Result<Options> {
+        if let Some(n) = args.threads {
+            if !(1..=MAX_THREADS).contains(&n) {
+                bail!("--threads must be between 1 and {MAX_THREADS}, got {n}");
+            }
+        }
+        Ok(Options {
+            scene: args.scene,
+            out: args.out,
+            seed: args.seed,
+            threads: args.threads,
+            resume: args.resume,
+            report: args.report,
+            quiet: args.quiet,
+        })
+    }
+}
+
+/// Solve the scene, saving progress as it goes, then write the pictures and exports.
+pub(super) fn run(opts: &Options) -> Result<()> {
+    let scene = load::scene(&opts.scene)?;
+    let out = opts
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("export").join(&scene.name));
+    let problem = Problem::new(scene);
+    let scene = &problem.scene;
+    let mut prior = Vec::new();
+    let resume_from = if opts.resume {
+        let file = out.join("solution.json");
+        let s = files::read_solution(&file)
+            .with_context(|| format!("cannot resume from {}", out.display()))?;
+        solution::check_resumable(scene, &s)
+            .with_context(|| format!("cannot resume from {}", file.display()))?;
+        if s.stages_completed >= s.stages_total {
+            eprintln!(
+                "{}: all {} stages are done already; nothing to resume",
+                file.display(),
+                s.stages_total
+            );
+            return Ok(());
+        }
+        let conv = out.join("convergence.csv");
+        if conv.exists() {
+            prior = files::read_convergence(&conv, s.stages_completed)?;
+        }
+        eprintln!(
+            "resuming after stage {}/{}",
+            s.stages_completed, s.stages_total
+        );
+        Some(s)
+    } else {
+        None
+    };
+    std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
+    ctrlc::set_handler(|| {
+        let n = INTERRUPTS.fetch_add(1, Ordering::SeqCst) + 1;
+        if n == 1 {
+            eprintln!("\ninterrupt: ending this stage (press Ctrl-C again to stop and save the best so far)");
+        } else {
+            eprintln!("\ninterrupt: stopping and saving the best so far");
+        }
+    })
+    .context("cannot install the Ctrl-C handler")?;
+    let mut observer = SolveProgress::new(out.clone(), scene, prior.clone(), opts.quiet);
+    // A resumed solve keeps the seed it was started with.
+    let seed = resume_from.as_ref().map(|s| s.seed).or(opts.seed);
+    let options = SolveOptions {
+        threads: opts.threads,
+        seed,
+        resume: resume_from,
+    };
+    let (solution, records) = solver::solve(&problem, &options, &mut observer, &INTERRUPTS);
+    if let Some(e) = observer.error.take() {
+        return Err(e.context("while saving progress"));
+    }
+    let mut all = prior;
+    all.extend(records);
+    files::write_solution(&out, &solution)?;
+    files::write_convergence(&out, &observer.stage_names, &all)?;
+    let mut ws = problem.workspace();
+    let params = solution.parameters();
+    problem.evaluate(&params, &Weights::all_ones(), &mut ws);
+    files::write_pictures(&out, &scene.target, &ws.mask)?;
+    files::write_preview(&out, &scene.target, &ws.mask)?;
+    let exported = export::write_exports(
+        &out,
+        &problem,
+        &solution,
+        crate::output::trajectory::DEFAULT_AFTER,
+    )?;
+    println!(
+        "{}: IoU at t {:.4}, {} before t ({} contacts), {} samples in {} iterations, {:.2} s on {} threads{}",
+        scene.name,
+        solution.iou,
+        if solution.n_contacts == 0 {
+            "no contact".to_string()
+        } else {
+            format!("first contact at {:.4} s", solution.t_sim)
+        },
+        solution.n_contacts,
+        solution.samples,
+        solution.iterations,
+        solution.wall_time_s,
+        solution.threads,
+        if solution.complete { "" } else { " (stopped early)" }
+    );
+    println!("{exported}");
+    if opts.report {
+        print_report(&solution);
+    }
+    Ok(())
+}
+
+/// The performance report of `--report`.
+fn print_report(s: &Solution) {
+    println!("\nPerformance (as the paper's Tables 3 and 4)");
+    let n = s.stages.len().max(1) as f64;
+    println!("  stages               {}", s.stages.len());
+    println!("  total iterations     {}", s.iterations);
+    println!("  average iterations   {:.2}", s.iterations as f64 / n);
+    println!("  total samples        {}", s.samples);
+    println!("  average samples      {:.1}", s.samples as f64 / n);
+    println!(
+        "  total running time   {:.2} s ({} threads)",
+        s.wall_time_s, s.threads
+    );
+    println!("  time per sample phase (one core, microseconds):");
+    for (k, v) in &s.time_per_term_us {
+        println!("    {k:<26} {v:>10.2}");
+    }
+}
