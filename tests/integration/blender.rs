@@ -1,0 +1,116 @@
+//! The cross-check with Blender (bpy, Cycles): the Cycles shadow at t matches the
+//! rasterizer, Blender imports the glTF with its animation, light, cameras and frame
+//! range, and the video renders. Every test here needs Blender's bpy in `.venv-blender`
+//! (`bash blender/setup_venv.sh`), so they are ignored by plain `cargo test`;
+//! `scripts/test.sh` installs bpy and runs them (`cargo test -- --include-ignored`).
+
+use std::process::Command;
+
+use bsa::evaluate::Problem;
+
+use crate::util::{bsa, example_scenes, quick_solve, require, root};
+
+#[test]
+#[ignore = "needs Blender's bpy in .venv-blender (bash blender/setup_venv.sh); run by scripts/test.sh"]
+fn cycles_mask_matches_the_rasterizer() {
+    for scene in example_scenes() {
+        let name = scene.file_name().unwrap().to_str().unwrap().to_string();
+        let out = quick_solve(&scene, &format!("cycles-{name}"));
+        let (ok, stdout, err) = bsa(&["validate", out.to_str().unwrap()]);
+        assert!(ok, "{err}");
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("validate.json")).unwrap())
+                .unwrap();
+        let iou = v["iou"].as_f64().unwrap();
+        eprintln!("{name}: {stdout}");
+        assert!(iou >= 0.995, "{name}: Cycles vs rasterizer IoU {iou}");
+        assert!(out.join("validate_diff.png").is_file());
+    }
+}
+
+#[test]
+#[ignore = "needs Blender's bpy in .venv-blender (bash blender/setup_venv.sh); run by scripts/test.sh"]
+fn import_keeps_animation_light_cameras_and_frame_range() {
+    require(
+        &root().join(".venv-blender/bin/python"),
+        "bash blender/setup_venv.sh",
+    );
+    let out = quick_solve(&root().join("scenes/mickey"), "blender-import");
+    let o = Command::new(root().join(".venv-blender/bin/python"))
+        .arg(root().join("blender/check_import.py"))
+        .args(["--", "--glb"])
+        .arg(out.join("mickey.glb"))
+        .output()
+        .expect("the bpy virtualenv (bash blender/setup_venv.sh)");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let line = stdout
+        .lines()
+        .rev()
+        .find_map(|l| l.strip_prefix("BSA_RESULT "))
+        .unwrap_or_else(|| panic!("{}", String::from_utf8_lossy(&o.stderr)));
+    let v: serde_json::Value = serde_json::from_str(line).unwrap();
+    assert_eq!(v["fps"].as_f64().unwrap(), 60.0);
+    assert_eq!(v["frame_t"].as_f64().unwrap(), 72.0);
+    assert_eq!(v["frame_start"], 0);
+    assert_eq!(v["frame_end"], 132, "t + 1 s at 60 fps");
+    assert_eq!(v["cameras"]["camera_shadow"]["type"], "ORTHO");
+    assert!(
+        (v["cameras"]["camera_shadow"]["ortho_scale"]
+            .as_f64()
+            .unwrap()
+            - 4.0)
+            .abs()
+            < 1e-5
+    );
+    assert_eq!(v["cameras"]["camera_view"]["type"], "PERSP");
+    assert_eq!(v["lights"]["light"]["type"], "POINT");
+    let light = &v["poses_at_t"]["light"]["location"];
+    assert!((light[2].as_f64().unwrap() - 6.0).abs() < 1e-5, "{light}");
+    // The animation plays: each occluder is where the solver put it at t.
+    let p = Problem::new(bsa::scene::load(&root().join("scenes/mickey")).unwrap());
+    let sol = bsa::output::files::read_solution(&out.join("solution.json")).unwrap();
+    let mut ws = p.workspace();
+    p.fly(&sol.parameters(), &mut ws);
+    for (i, o) in p.scene.occluders.iter().enumerate() {
+        let loc = &v["poses_at_t"][&o.name]["location"];
+        let got = glam::DVec3::new(
+            loc[0].as_f64().unwrap(),
+            loc[1].as_f64().unwrap(),
+            loc[2].as_f64().unwrap(),
+        );
+        assert!(
+            got.distance(ws.poses[i].0) < 1e-4,
+            "{}: Blender {got} vs solver {}",
+            o.name,
+            ws.poses[i].0
+        );
+    }
+}
+
+#[test]
+#[ignore = "needs Blender's bpy in .venv-blender (bash blender/setup_venv.sh); run by scripts/test.sh"]
+fn video_of_mickey_renders_an_mp4() {
+    let out = quick_solve(&root().join("scenes/mickey"), "video");
+    let mp4 = out.join("short.mp4");
+    let (ok, _, err) = bsa(&[
+        "video",
+        out.to_str().unwrap(),
+        "--out",
+        mp4.to_str().unwrap(),
+        "--samples",
+        "1",
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "--seconds",
+        "0.2",
+    ]);
+    assert!(ok, "{err}");
+    let bytes = std::fs::read(&mp4).unwrap();
+    assert!(
+        bytes.len() > 1000 && &bytes[4..8] == b"ftyp",
+        "not an MP4 ({} bytes)",
+        bytes.len()
+    );
+}

@@ -1,0 +1,187 @@
+//! The command line end to end: `bsa check`, `solve` with every output file, `eval`
+//! reading a solution back, and clear errors from `export`, `validate` and `video` when
+//! their input is missing, corrupt or belongs to another scene.
+
+use std::path::Path;
+use std::process::Command;
+
+use crate::util::{bsa, quick_solve, root, tmpdir, variant};
+
+#[test]
+fn check_accepts_mickey() {
+    let (ok, out, err) = bsa(&["check", "scenes/mickey"]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("scene `mickey`") && out.contains("ok"),
+        "{out}"
+    );
+}
+
+#[test]
+fn solve_and_eval_from_the_command_line() {
+    // A short run of the real command (few iterations) writes every output file, and
+    // `eval` reads the solution back.
+    let d = variant("cli", |v| {
+        for s in v["stages"].as_array_mut().unwrap() {
+            s["max_iterations"] = 5.into();
+            s["population"] = 12.into();
+        }
+    });
+    let out = d.join("out");
+    let (ok, stdout, err) = bsa(&[
+        "solve",
+        d.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--report",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        stdout.contains("IoU at t") && stdout.contains("total samples"),
+        "{stdout}"
+    );
+    for f in [
+        "solution.json",
+        "shadow.png",
+        "overlay.png",
+        "preview.png",
+        "convergence.csv",
+        "convergence.png",
+    ] {
+        assert!(out.join(f).is_file(), "missing {f}");
+    }
+    let csv = std::fs::read_to_string(out.join("convergence.csv")).unwrap();
+    assert_eq!(
+        csv.lines().count(),
+        1 + 2 * 5 * 12,
+        "one row per sample plus the header"
+    );
+    assert!(
+        csv.starts_with("stage,iteration,d0,d1,d2,xor,inner,outer,contact,reg,hint,barrier,total")
+    );
+    let sol = out.join("solution.json");
+    let (ok, stdout, err) = bsa(&[
+        "eval",
+        d.to_str().unwrap(),
+        "--solution",
+        sol.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    for k in [
+        "d0", "d1", "d2", "xor", "inner", "outer", "contact", "reg", "hint", "barrier",
+    ] {
+        assert!(v["terms"][k]["raw"].is_number(), "{k} missing: {stdout}");
+    }
+    let (ok, stdout, _) = bsa(&[
+        "eval",
+        d.to_str().unwrap(),
+        "--solution",
+        sol.to_str().unwrap(),
+    ]);
+    assert!(
+        ok && stdout.contains("XOR") && stdout.contains("total"),
+        "{stdout}"
+    );
+    // Resuming a complete solution does nothing and says so.
+    let (ok, _, err) = bsa(&[
+        "solve",
+        d.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--resume",
+        "--quiet",
+    ]);
+    assert!(ok && err.contains("nothing to resume"), "{err}");
+    // A solution from another scene is refused.
+    let other = variant("cli-other", |v| v["name"] = "other".into());
+    let (ok, _, err) = bsa(&[
+        "eval",
+        other.to_str().unwrap(),
+        "--solution",
+        sol.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("not `other`"), "{err}");
+    // A corrupt solution file is refused.
+    std::fs::write(&sol, "{ not json").unwrap();
+    let (ok, _, err) = bsa(&[
+        "eval",
+        d.to_str().unwrap(),
+        "--solution",
+        sol.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("not a valid solution file") && !err.contains("panicked"),
+        "{err}"
+    );
+}
+
+#[test]
+fn bad_input_to_export_validate_and_video() {
+    // Missing solution.
+    let empty = tmpdir("export-empty");
+    for cmd in ["export", "validate", "video"] {
+        let (ok, _, err) = bsa(&[cmd, empty.to_str().unwrap()]);
+        assert!(
+            !ok && err.contains("no solution.json") && !err.contains("panicked"),
+            "{cmd}: {err}"
+        );
+    }
+    let out = quick_solve(&root().join("scenes/mickey"), "export-bad");
+    // A solution of another scene.
+    let other = variant("export-other", |v| v["name"] = "other".into());
+    let (ok, _, err) = bsa(&[
+        "export",
+        out.to_str().unwrap(),
+        "--scene",
+        other.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("does not belong") && err.contains("not `other`"),
+        "{err}"
+    );
+    // No bpy in the given Python.
+    let (ok, _, err) = bsa(&[
+        "validate",
+        out.to_str().unwrap(),
+        "--python",
+        "/nonexistent/python3",
+    ]);
+    assert!(!ok && err.contains("does not exist"), "{err}");
+    let sys_python = ["/usr/bin/python3", "/usr/local/bin/python3"]
+        .into_iter()
+        .find(|p| Path::new(p).exists());
+    if let Some(py) = sys_python {
+        let has_bpy = Command::new(py)
+            .args(["-c", "import bpy"])
+            .output()
+            .map(|o| o.status.success())
+            .unwrap_or(false);
+        if !has_bpy {
+            let (ok, _, err) = bsa(&["validate", out.to_str().unwrap(), "--python", py]);
+            assert!(
+                !ok && err.contains("no bpy module") && err.contains("setup_venv.sh"),
+                "{err}"
+            );
+        }
+    }
+    // A corrupt .glb.
+    std::fs::write(out.join("mickey.glb"), b"glTF garbage").unwrap();
+    for cmd in ["validate", "video"] {
+        let (ok, _, err) = bsa(&[cmd, out.to_str().unwrap()]);
+        assert!(
+            !ok && err.contains("not a valid glTF") && !err.contains("panicked"),
+            "{cmd}: {err}"
+        );
+    }
+    // A missing .glb.
+    std::fs::remove_file(out.join("mickey.glb")).unwrap();
+    let (ok, _, err) = bsa(&["validate", out.to_str().unwrap()]);
+    assert!(!ok && err.contains("run `bsa export"), "{err}");
+    // A corrupt solution.
+    std::fs::write(out.join("solution.json"), "[1, 2").unwrap();
+    let (ok, _, err) = bsa(&["export", out.to_str().unwrap()]);
+    assert!(!ok && err.contains("not a valid solution file"), "{err}");
+}

@@ -1,0 +1,141 @@
+//! Bad scenes get clear errors: `bsa check` fails without a panic, naming the file and
+//! the field at fault.
+
+use std::path::Path;
+
+use crate::util::{bsa, tmpdir, variant};
+
+/// `bsa check` on a bad scene must fail cleanly, naming the file and the field.
+fn assert_rejected(dir: &Path, expect: &[&str]) {
+    let (ok, _, err) = bsa(&["check", dir.to_str().unwrap()]);
+    assert!(!ok, "accepted a bad scene in {}", dir.display());
+    assert!(!err.contains("panicked"), "panicked: {err}");
+    for e in expect {
+        assert!(err.contains(e), "error message lacks `{e}`:\n{err}");
+    }
+}
+
+#[test]
+fn missing_scene_folder_is_named() {
+    let (ok, _, err) = bsa(&["check", "scenes/does-not-exist"]);
+    assert!(
+        !ok && err.contains("does-not-exist") && !err.contains("panicked"),
+        "{err}"
+    );
+}
+
+#[test]
+fn malformed_json_and_unknown_fields_are_refused() {
+    // Malformed JSON.
+    let d = tmpdir("malformed");
+    std::fs::write(d.join("scene.json"), "{ \"t\": 1.2, ").unwrap();
+    assert_rejected(&d, &["scene.json", "EOF"]);
+
+    // Unknown field.
+    let d = variant("unknown", |v| v["colour"] = "red".into());
+    assert_rejected(&d, &["scene.json", "unknown field `colour`"]);
+}
+
+#[test]
+fn occluder_named_after_an_export_node_is_refused_at_load() {
+    // An occluder named after a node of the glTF export: refused when the scene is
+    // loaded, not after the solve when the export runs.
+    let d = variant("reserved", |v| v["occluders"][1]["name"] = "table".into());
+    assert_rejected(&d, &["scene.json", "occluders[1].name", "`table`"]);
+}
+
+#[test]
+fn target_that_is_not_a_png_or_has_no_dark_pixel_is_refused() {
+    // Target that is not a PNG.
+    let d = variant("notpng", |_| {});
+    std::fs::write(d.join("target.png"), b"GIF89a not a png").unwrap();
+    assert_rejected(&d, &["target.png", "not a readable PNG"]);
+
+    // Target with no dark pixel.
+    let d = variant("white", |_| {});
+    image::GrayImage::from_pixel(64, 48, image::Luma([255]))
+        .save(d.join("target.png"))
+        .unwrap();
+    assert_rejected(&d, &["target.png", "no dark pixel"]);
+}
+
+#[test]
+fn non_positive_time_radius_size_and_mass_are_refused() {
+    // t <= 0.
+    let d = variant("t0", |v| v["t"] = 0.0.into());
+    assert_rejected(&d, &["scene.json", "`t`", "positive"]);
+    let d = variant("tneg", |v| v["t"] = (-1.0).into());
+    assert_rejected(&d, &["`t`", "positive"]);
+
+    // Non-positive radius, size, mass.
+    let d = variant("radius", |v| {
+        v["occluders"][1]["shape"]["sphere"]["radius"] = 0.0.into()
+    });
+    assert_rejected(&d, &["occluders[1].shape.sphere.radius", "positive"]);
+    let d = variant("size", |v| {
+        v["occluders"][0]["shape"] = serde_json::json!({"box": {"size": [0.5, -0.1, 0.5]}});
+    });
+    assert_rejected(&d, &["occluders[0].shape.box.size[1]", "positive"]);
+    let d = variant("mass", |v| v["occluders"][2]["mass"] = (-2.0).into());
+    assert_rejected(&d, &["occluders[2].mass", "positive"]);
+}
+
+#[test]
+fn infinity_and_nan_in_scene_hints_and_obj_are_refused() {
+    // Infinity (JSON has no NaN literal; an overflowing number is how it arrives).
+    let d = variant("inf", |_| {});
+    let text = std::fs::read_to_string(d.join("scene.json"))
+        .unwrap()
+        .replacen("\"t\": 1.2", "\"t\": 1e999", 1);
+    std::fs::write(d.join("scene.json"), text).unwrap();
+    assert_rejected(&d, &["scene.json"]);
+    // NaN in a hints file.
+    let d = variant("nanhint", |v| v["hints"] = "hints.txt".into());
+    std::fs::write(d.join("hints.txt"), "head 0 0 0 320 NaN 100\n").unwrap();
+    assert_rejected(&d, &["hints.txt:1", "finite"]);
+    // NaN in an OBJ.
+    let d = variant("nanobj", |v| {
+        v["occluders"][0]["shape"] = serde_json::json!({"mesh": {"obj": "bad.obj"}});
+    });
+    std::fs::write(
+        d.join("bad.obj"),
+        "v 0 0 0\nv 1 0 0\nv nan 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n",
+    )
+    .unwrap();
+    assert_rejected(&d, &["bad.obj", "occluders[0].shape.mesh.obj"]);
+}
+
+#[test]
+fn obj_with_no_faces_is_refused() {
+    let d = variant("nofaces", |v| {
+        v["occluders"][0]["shape"] = serde_json::json!({"mesh": {"obj": "empty.obj"}});
+    });
+    std::fs::write(d.join("empty.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\n").unwrap();
+    assert_rejected(&d, &["empty.obj", "occluders[0].shape.mesh.obj"]);
+}
+
+#[test]
+fn light_on_or_behind_the_receiver_is_refused() {
+    let d = variant("lighton", |v| {
+        v["light"] = serde_json::json!([0.0, 0.0, 0.0])
+    });
+    assert_rejected(&d, &["`light`", "behind the receiver"]);
+    let d = variant("lightbehind", |v| {
+        v["light"] = serde_json::json!([0.0, 0.0, -3.0])
+    });
+    assert_rejected(&d, &["`light`", "behind the receiver"]);
+}
+
+#[test]
+fn hint_naming_a_missing_occluder_is_refused() {
+    let d = variant("hint", |v| v["hints"][1]["occluder"] = "nose".into());
+    assert_rejected(&d, &["hints[1].occluder", "`nose`"]);
+}
+
+#[test]
+fn occluders_overlapping_at_launch_are_refused() {
+    let d = variant("overlap", |v| {
+        v["occluders"][1]["position"] = serde_json::json!([0.3, -1.8, 0.6])
+    });
+    assert_rejected(&d, &["`head` and `left_ear` overlap"]);
+}

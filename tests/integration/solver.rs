@@ -1,0 +1,303 @@
+//! The solver through the library: determinism across thread counts and seeds, resume
+//! after an interrupt, the sequential strategy, the golden shadow of a fixed launch, the
+//! example scenes' start guesses, and the full Mickey solve.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use bsa::evaluate::Problem;
+use bsa::optimize::solver::{self, Observer, SolveOptions};
+use bsa::output::solution::{SampleRecord, Solution};
+
+use crate::util::{root, variant};
+
+fn small_mickey(iterations: usize) -> Problem {
+    let mut scene = bsa::scene::load(&root().join("scenes/mickey")).unwrap();
+    for s in &mut scene.stages {
+        s.max_iterations = iterations;
+        s.population = 16;
+    }
+    Problem::new(scene)
+}
+
+fn params_bits(s: &Solution) -> Vec<u64> {
+    s.parameters().iter().map(|x| x.to_bits()).collect()
+}
+
+#[test]
+fn same_seed_gives_bit_identical_solution_with_1_and_2_threads() {
+    let p = small_mickey(12);
+    let none = AtomicUsize::new(0);
+    let run = |threads| {
+        let opts = SolveOptions {
+            threads: Some(threads),
+            seed: Some(7),
+            resume: None,
+        };
+        solver::solve(&p, &opts, &mut solver::Silent, &none)
+    };
+    let (a, ra) = run(1);
+    let (b, rb) = run(2);
+    assert_eq!(params_bits(&a), params_bits(&b));
+    assert_eq!(a.total_energy.to_bits(), b.total_energy.to_bits());
+    assert_eq!(ra, rb);
+    // A different seed explores differently.
+    let opts = SolveOptions {
+        threads: Some(2),
+        seed: Some(8),
+        resume: None,
+    };
+    let (c, _) = solver::solve(&p, &opts, &mut solver::Silent, &none);
+    assert_ne!(params_bits(&a), params_bits(&c));
+}
+
+/// Raises the interrupt counter twice once the first stage is done: the solve must stop
+/// and hand back a solution with one completed stage.
+struct StopAfterFirstStage<'a>(&'a AtomicUsize);
+impl Observer for StopAfterFirstStage<'_> {
+    fn stage_finished(&mut self, _s: &Solution, _r: &[SampleRecord]) {
+        self.0.store(2, Ordering::SeqCst);
+    }
+}
+
+#[test]
+fn resume_continues_to_the_same_result() {
+    let p = small_mickey(10);
+    let opts = SolveOptions {
+        threads: Some(2),
+        seed: Some(3),
+        resume: None,
+    };
+    let none = AtomicUsize::new(0);
+    let (full, _) = solver::solve(&p, &opts, &mut solver::Silent, &none);
+    assert!(full.complete);
+    let counter = AtomicUsize::new(0);
+    let (partial, _) = solver::solve(&p, &opts, &mut StopAfterFirstStage(&counter), &counter);
+    assert_eq!(partial.stages_completed, 1);
+    assert!(!partial.complete);
+    // Round-trip through JSON as the CLI does.
+    let text = serde_json::to_string(&partial).unwrap();
+    let partial: Solution = serde_json::from_str(&text).unwrap();
+    let opts2 = SolveOptions {
+        resume: Some(partial),
+        ..opts
+    };
+    let (resumed, _) = solver::solve(&p, &opts2, &mut solver::Silent, &none);
+    assert_eq!(resumed.stages_completed, 2);
+    assert_eq!(params_bits(&resumed), params_bits(&full));
+}
+
+/// Raises the interrupt counter to 2 in the middle of the first stage (a double Ctrl-C).
+struct StopMidFirstStage<'a>(&'a AtomicUsize);
+impl Observer for StopMidFirstStage<'_> {
+    fn iteration(&mut self, info: &solver::IterationInfo) {
+        if info.stage_index == 0 && info.iteration == 3 {
+            self.0.store(2, Ordering::SeqCst);
+        }
+    }
+}
+
+#[test]
+fn a_stage_stopped_by_a_second_interrupt_runs_again_on_resume() {
+    let p = small_mickey(10);
+    let counter = AtomicUsize::new(0);
+    let opts = SolveOptions {
+        threads: Some(2),
+        seed: Some(5),
+        resume: None,
+    };
+    let (stopped, _) = solver::solve(&p, &opts, &mut StopMidFirstStage(&counter), &counter);
+    assert_eq!(stopped.stages_completed, 0);
+    assert!(!stopped.complete);
+    assert_eq!(stopped.stages.len(), 1);
+    assert!(
+        stopped.stages[0].stop.starts_with("stopped"),
+        "{}",
+        stopped.stages[0].stop
+    );
+    // The best so far is kept: it is no worse than the start.
+    let mut ws = p.workspace();
+    let w = p.scene.stages[0].weights;
+    let start = p.evaluate(&p.scene.start_parameters(), &w, &mut ws).total;
+    let kept = p.evaluate(&stopped.parameters(), &w, &mut ws).total;
+    assert!(kept <= start);
+    let none = AtomicUsize::new(0);
+    let (resumed, _) = solver::solve(
+        &p,
+        &SolveOptions {
+            resume: Some(stopped),
+            ..opts
+        },
+        &mut solver::Silent,
+        &none,
+    );
+    assert_eq!(resumed.stages_completed, 2);
+    assert!(resumed.complete);
+    assert_eq!(resumed.stages.len(), 2);
+    assert_eq!(resumed.stages[0].iterations, 10);
+}
+
+/// The shadow of a fixed launch, compared with a committed golden image. Set
+/// `BSA_UPDATE_GOLDEN=1` to regenerate it; on failure a diff image is written next to
+/// the golden file (red: only in the golden, blue: only now).
+#[test]
+fn golden_shadow_of_a_fixed_launch() {
+    let p = Problem::new(bsa::scene::load(&root().join("scenes/mickey")).unwrap());
+    // Launch values written by hand: each ball thrown toward the middle of the picture,
+    // the head with a spin that must not matter for a sphere.
+    let params = [
+        0.0, 1.6, 7.9, 0.0, 3.0, 0.0, //
+        1.5, -0.4, 8.4, 0.0, 0.0, 0.0, //
+        -1.5, -0.4, 8.4, 0.0, 0.0, 0.0,
+    ];
+    let mut ws = p.workspace();
+    p.evaluate(&params, &bsa::energy::Weights::all_ones(), &mut ws);
+    let golden = root().join("tests/golden/mickey_fixed_launch.png");
+    let now = bsa::output::picture::mask_image(ws.mask.width(), ws.mask.height(), &|x, y| {
+        ws.mask.get(x, y)
+    });
+    if std::env::var_os("BSA_UPDATE_GOLDEN").is_some() {
+        std::fs::create_dir_all(golden.parent().unwrap()).unwrap();
+        now.save(&golden).unwrap();
+        return;
+    }
+    let old = image::open(&golden)
+        .expect("golden image (run with BSA_UPDATE_GOLDEN=1 to create it)")
+        .to_luma8();
+    assert_eq!(old.dimensions(), now.dimensions());
+    let differing = old
+        .pixels()
+        .zip(now.pixels())
+        .filter(|(a, b)| a != b)
+        .count();
+    if differing > 0 {
+        let diff = bsa::output::picture::difference_image(
+            old.width() as usize,
+            old.height() as usize,
+            &|x, y| old.get_pixel(x as u32, y as u32).0[0] < 128,
+            &|x, y| now.get_pixel(x as u32, y as u32).0[0] < 128,
+        );
+        let path = golden.with_file_name("mickey_fixed_launch.diff.png");
+        diff.save(&path).unwrap();
+        panic!(
+            "{differing} pixels differ from the golden image; see {}",
+            path.display()
+        );
+    }
+}
+
+#[test]
+fn mickey_solves_to_iou_099_without_contact() {
+    let p = Problem::new(bsa::scene::load(&root().join("scenes/mickey")).unwrap());
+    let none = AtomicUsize::new(0);
+    let (s, records) = solver::solve(&p, &SolveOptions::default(), &mut solver::Silent, &none);
+    assert!(s.iou >= 0.99, "IoU {}", s.iou);
+    assert_eq!(s.n_contacts, 0);
+    assert_eq!(s.t_sim, s.t);
+    assert_eq!(records.len(), s.samples);
+}
+
+/// Records the launch values after every stage.
+struct StageSnapshots(Vec<Vec<f64>>);
+impl Observer for StageSnapshots {
+    fn stage_finished(&mut self, s: &Solution, _r: &[SampleRecord]) {
+        self.0.push(s.parameters());
+    }
+}
+
+#[test]
+fn sequential_strategy_varies_one_occluder_per_stage_then_all() {
+    // Mickey with boxes for ears and the sequential strategy in automatic order.
+    let d = variant("sequential", |v| {
+        v["occluders"][1]["shape"] = serde_json::json!({"box": {"size": [0.5, 0.4, 0.3]}});
+        v["occluders"][1]["position"] = serde_json::json!([-2.3, 0.9, 0.15]);
+        v["occluders"][2]["shape"] = serde_json::json!({"box": {"size": [0.6, 0.5, 0.4]}});
+        v["occluders"][2]["position"] = serde_json::json!([2.3, 0.9, 0.2]);
+        let stage = v["stages"][1].clone();
+        v.as_object_mut().unwrap().remove("stages");
+        let mut one = stage.clone();
+        one["max_iterations"] = 8.into();
+        one["population"] = 12.into();
+        one.as_object_mut().unwrap().remove("name");
+        let mut last = one.clone();
+        last["step"] = 0.05.into();
+        v["strategy"] =
+            serde_json::json!({"kind": "sequential", "order": "auto", "stage": one, "final": last});
+    });
+    let scene = bsa::scene::load(&d).unwrap();
+    let names: Vec<&str> = scene.stages.iter().map(|s| s.name.as_str()).collect();
+    // Largest volume first: the head sphere, then the larger box, then the smaller one.
+    assert_eq!(names, ["head", "right_ear", "left_ear", "final"]);
+    assert_eq!(scene.stages[3].vary, vec![0, 1, 2]);
+    let p = Problem::new(scene);
+    let start = p.scene.start_parameters();
+    let mut snaps = StageSnapshots(Vec::new());
+    let none = AtomicUsize::new(0);
+    let (s, _) = solver::solve(&p, &SolveOptions::default(), &mut snaps, &none);
+    assert_eq!(s.stages_completed, 4);
+    let mut before = start;
+    for (k, after) in snaps.0.iter().take(3).enumerate() {
+        let varied = p.scene.stages[k].vary[0];
+        for i in 0..3 {
+            let same = before[6 * i..6 * i + 6] == after[6 * i..6 * i + 6];
+            assert_eq!(
+                same,
+                i != varied,
+                "stage {k}: occluder {i} changed={}",
+                !same
+            );
+        }
+        before = after.clone();
+    }
+}
+
+#[test]
+fn sequential_rounds_repeat_the_pass_and_are_checked() {
+    let with_rounds = |rounds: serde_json::Value| {
+        variant("rounds", move |v| {
+            let mut stage = v["stages"][1].clone();
+            v.as_object_mut().unwrap().remove("stages");
+            stage.as_object_mut().unwrap().remove("name");
+            v["strategy"] = serde_json::json!({
+                "kind": "sequential", "order": ["left_ear", "head"], "rounds": rounds,
+                "stage": stage, "final": stage
+            });
+        })
+    };
+    let scene = bsa::scene::load(&with_rounds(2.into())).unwrap();
+    let names: Vec<&str> = scene.stages.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["left_ear", "head", "left_ear (2)", "head (2)", "final"]
+    );
+    assert_eq!(scene.stages[2].vary, vec![1]);
+    for bad in [0, 101] {
+        let err = bsa::scene::load(&with_rounds(bad.into())).unwrap_err();
+        let msg = format!("{err:#}");
+        assert!(
+            msg.contains("strategy.rounds") && msg.contains("1 to 100"),
+            "{msg}"
+        );
+    }
+}
+
+#[test]
+fn example_scenes_start_without_contact_near_their_targets() {
+    // The generator (tools/make_scenes.py) promises start guesses that fly without
+    // contact; the solver's sequential stages rely on it (a held pair that collides hides
+    // every later contact from the stage's penalty).
+    for name in ["fly", "tbc", "thinker"] {
+        let p = Problem::new(bsa::scene::load(&root().join("scenes").join(name)).unwrap());
+        let mut ws = p.workspace();
+        let e = p.evaluate(
+            &p.scene.start_parameters(),
+            &bsa::energy::Weights::all_ones(),
+            &mut ws,
+        );
+        assert_eq!(
+            e.outcome.n_contacts, 0,
+            "{name}: {:?}",
+            e.outcome.first_contact
+        );
+        assert!(e.iou > 0.5, "{name}: start IoU {}", e.iou);
+    }
+}

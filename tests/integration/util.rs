@@ -1,0 +1,115 @@
+//! Helpers shared by the integration tests: running the `bsa` binary, fresh temporary
+//! folders, variants of the Mickey scene, quick solves through the command line, and the
+//! check that a tool an ignored test needs is installed.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The repository root, where the tests run `bsa`.
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Runs the `bsa` binary from the repository root: (success, stdout, stderr).
+pub fn bsa(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_bsa"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("run bsa");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A fresh, empty folder under the system's temporary folder, named after the test.
+pub fn tmpdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("bsa-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn mickey_json() -> serde_json::Value {
+    let text = std::fs::read_to_string(root().join("scenes/mickey/scene.json")).unwrap();
+    serde_json::from_str(&text).unwrap()
+}
+
+/// Write a variant of the Mickey scene into a fresh folder (with the real target).
+pub fn variant(name: &str, edit: impl FnOnce(&mut serde_json::Value)) -> PathBuf {
+    let d = tmpdir(name);
+    std::fs::copy(
+        root().join("scenes/mickey/target.png"),
+        d.join("target.png"),
+    )
+    .unwrap();
+    let mut v = mickey_json();
+    edit(&mut v);
+    std::fs::write(
+        d.join("scene.json"),
+        serde_json::to_string_pretty(&v).unwrap(),
+    )
+    .unwrap();
+    d
+}
+
+/// Every folder of `scenes/` that holds a scene.json.
+pub fn example_scenes() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("scenes"))
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.join("scene.json").is_file())
+        .collect();
+    v.sort();
+    assert!(!v.is_empty());
+    v
+}
+
+/// Solve a scene quickly (few iterations) into a fresh folder with the CLI, which also
+/// writes the .glb and the CSV tables.
+pub fn quick_solve(scene: &Path, name: &str) -> PathBuf {
+    let d = tmpdir(name);
+    let text = std::fs::read_to_string(scene.join("scene.json")).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    // Keep the scene's own files reachable: absolute target, meshes and hints paths.
+    let abs = |p: &serde_json::Value| {
+        serde_json::Value::from(scene.join(p.as_str().unwrap()).display().to_string())
+    };
+    v["target"] = abs(&v["target"]);
+    if let Some(h) = v.get("hints").filter(|h| h.is_string()).cloned() {
+        v["hints"] = abs(&h);
+    }
+    for o in v["occluders"].as_array_mut().unwrap() {
+        if let Some(obj) = o["shape"].get("mesh").map(|m| m["obj"].clone()) {
+            o["shape"]["mesh"]["obj"] = abs(&obj);
+        }
+    }
+    if let Some(stages) = v.get_mut("stages").and_then(|s| s.as_array_mut()) {
+        for s in stages {
+            s["max_iterations"] = 4.into();
+        }
+    }
+    std::fs::write(d.join("scene.json"), serde_json::to_string(&v).unwrap()).unwrap();
+    let out = d.join("out");
+    let (ok, _, err) = bsa(&[
+        "solve",
+        d.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(ok, "{err}");
+    out
+}
+
+/// Panics, saying how to install it, when a tool that an ignored test needs is missing:
+/// an ignored test that is run runs for real or fails, it never passes without checking.
+pub fn require(path: &Path, install: &str) {
+    assert!(
+        path.exists(),
+        "{} is missing: {install} (scripts/test.sh does it)",
+        path.display()
+    );
+}
