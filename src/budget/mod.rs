@@ -46,7 +46,7 @@ use crate::evaluate::{launch_velocities, Problem, Workspace, MAX_TURN};
 use crate::geometry::shape::Shape;
 use crate::output::solution::{check_solution, MismatchError, Solution};
 use crate::sim::drag::{self, BodyDrag, DragConfig, DragError};
-use crate::sim::flight::FreeFlight;
+use crate::sim::flight::{FreeFlight, LaunchState};
 
 /// The default IoU a shadow must reach to "read" as the picture
 /// ([`BudgetOptions::iou_threshold`]).
@@ -454,10 +454,12 @@ impl<'a> Budget<'a> {
             Some(f) => {
                 f.reset(
                     &o.mass,
-                    o.position,
-                    o.orientation,
-                    v,
-                    w,
+                    LaunchState {
+                        origin: o.position,
+                        orientation: o.orientation,
+                        velocity: v,
+                        angular_velocity: w,
+                    },
                     scene.gravity,
                     tau.max(scene.t),
                     &self.problem.flight,

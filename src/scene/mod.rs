@@ -25,7 +25,7 @@ use crate::geometry::distance::{
 pub use crate::geometry::shape::Table;
 use crate::geometry::shape::{self, MassProperties, Shape, TriMesh};
 use crate::shadow::mask::Mask;
-use crate::shadow::raster::ShadowCamera;
+use crate::shadow::raster::{ImageRect, ShadowCamera};
 
 /// Why a scene could not be loaded. Every variant names the file, and the field when
 /// one is at fault, so that the message alone tells the user what to fix.
@@ -479,13 +479,15 @@ impl Validator<'_> {
         let target = self.target(&raw.target)?;
         let camera = ShadowCamera::new(
             light,
-            receiver.center,
-            receiver.u,
-            receiver.v,
-            receiver.width,
-            receiver.height,
-            target.width(),
-            target.height(),
+            ImageRect {
+                center: receiver.center,
+                u: receiver.u,
+                v: receiver.v,
+                width_m: receiver.width,
+                height_m: receiver.height,
+                width_px: target.width(),
+                height_px: target.height(),
+            },
         );
         let table = match &raw.table {
             None => None,
