@@ -304,8 +304,6 @@ pub fn ball_radius(s: &ContactShape) -> f64 {
     }
 }
 
-/// First time in `[0, horizon]` at which the two bodies touch, if any. At least one of
-
 /// Signed distance from a posed shape to the table box (negative: penetration).
 pub fn table_signed_distance(
     shape: &ContactShape,
