@@ -27,6 +27,7 @@ use glam::{DQuat, DVec3};
 pub use crate::geometry::distance::CONTACT_DISTANCE;
 use crate::geometry::distance::{
     cover_gap, signed_distance, signed_distance_warm, table_signed_distance, ContactShape,
+    PosedShape,
 };
 use crate::geometry::gjk::Warm;
 use crate::geometry::shape::Table;
@@ -205,8 +206,20 @@ pub fn pair_contact_time(a: &Body, b: &Body, horizon: f64) -> Option<f64> {
         let (d, axis) = match cover_gap(a.shape, pa, qa, b.shape, pb, qb) {
             Some(lb) if lb > COVER_SWITCH => (lb, None),
             _ => {
-                let d =
-                    signed_distance_warm(a.shape, pa, qa, b.shape, pb, qb, CA_REL_TOL, &mut warm);
+                let d = signed_distance_warm(
+                    PosedShape {
+                        shape: a.shape,
+                        position: pa,
+                        orientation: qa,
+                    },
+                    PosedShape {
+                        shape: b.shape,
+                        position: pb,
+                        orientation: qb,
+                    },
+                    CA_REL_TOL,
+                    &mut warm,
+                );
                 (d.max(0.0), warm.axis().map(|n| qa * n))
             }
         };
@@ -277,7 +290,20 @@ fn touching_pair_contact_time(a: &Body, b: &Body, d0: f64, horizon: f64) -> Opti
     for _ in 0..MAX_STEPS {
         let (pa, qa) = a.motion.pose(s);
         let (pb, qb) = b.motion.pose(s);
-        let d = signed_distance_warm(a.shape, pa, qa, b.shape, pb, qb, CA_REL_TOL, &mut warm);
+        let d = signed_distance_warm(
+            PosedShape {
+                shape: a.shape,
+                position: pa,
+                orientation: qa,
+            },
+            PosedShape {
+                shape: b.shape,
+                position: pb,
+                orientation: qb,
+            },
+            CA_REL_TOL,
+            &mut warm,
+        );
         if !left && d > TABLE_LEAVE {
             left = true;
         }
