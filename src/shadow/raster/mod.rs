@@ -2,9 +2,9 @@
 //!
 //! [`ShadowCamera`] describes the receiver plane, the image rectangle on it and the point
 //! light; [`ShadowCamera::new`] precomputes everything the hot loops need. The
-//! `rasterize_*` methods OR an object's shadow into a [`Mask`] (they never clear it), and
-//! [`RasterScratch`] carries the reusable buffers of the mesh path so that nothing is
-//! allocated per call once it has warmed up. Typical use per candidate: `mask.clear()`,
+//! `rasterize_*` methods OR an object's shadow into a [`Mask`](crate::shadow::mask::Mask)
+//! (they never clear it), and [`RasterScratch`] carries the reusable buffers of the mesh
+//! path so that nothing is allocated per call once it has warmed up. Typical use per candidate: `mask.clear()`,
 //! then one `rasterize_*` call per object, then the energies read the mask.
 //!
 //! Pixel convention: pixel coordinates `px` in `[0, width_px]` run from the left edge,
