@@ -1,6 +1,6 @@
 //! Accuracy and cost of `FreeFlight` (run with `cargo run --release --example flight_bench`).
 use bsa::geometry::shape::{MassProperties, Shape};
-use bsa::sim::flight::{FlightConfig, FreeFlight};
+use bsa::sim::flight::{FlightConfig, FreeFlight, LaunchState};
 use glam::{DQuat, DVec3};
 use std::hint::black_box;
 use std::time::Instant;
@@ -33,10 +33,12 @@ fn cost_once(mp: &MassProperties, w: DVec3, t_max: f64, cfg: &FlightConfig) -> f
         let wi = w * (1.0 + 1e-4 * i as f64);
         f.reset(
             black_box(mp),
-            DVec3::ZERO,
-            q0,
-            DVec3::X,
-            wi,
+            LaunchState {
+                origin: DVec3::ZERO,
+                orientation: q0,
+                velocity: DVec3::X,
+                angular_velocity: wi,
+            },
             DVec3::NEG_Z * 9.81,
             t_max,
             cfg,
@@ -68,10 +70,12 @@ fn main() {
     let mut reference = FreeFlight::default();
     reference.reset(
         &brick,
-        DVec3::ZERO,
-        q0,
-        DVec3::ZERO,
-        w,
+        LaunchState {
+            origin: DVec3::ZERO,
+            orientation: q0,
+            velocity: DVec3::ZERO,
+            angular_velocity: w,
+        },
         DVec3::ZERO,
         t_end,
         &reference_cfg,
@@ -97,10 +101,12 @@ fn main() {
         let mut f = FreeFlight::default();
         f.reset(
             &brick,
-            DVec3::ZERO,
-            q0,
-            DVec3::ZERO,
-            w,
+            LaunchState {
+                origin: DVec3::ZERO,
+                orientation: q0,
+                velocity: DVec3::ZERO,
+                angular_velocity: w,
+            },
             DVec3::ZERO,
             t_end,
             &cfg,

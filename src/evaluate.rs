@@ -28,9 +28,9 @@ use crate::geometry::distance::{table_shape, ContactShape};
 use crate::geometry::shape::Shape;
 use crate::scene::{Launch, Scene};
 use crate::shadow::mask::Mask;
-use crate::shadow::raster::{MeshSilhouette, RasterScratch};
+use crate::shadow::raster::{ClosedMesh, MeshSilhouette, RasterScratch};
 use crate::sim::contact::{self, Body, Motion};
-use crate::sim::flight::{FlightConfig, FreeFlight};
+use crate::sim::flight::{FlightConfig, FreeFlight, LaunchState};
 
 /// Largest total rotation (rad) of a launched body by `t` that a sample may ask for; more
 /// (over 300 turns) is treated as a diverged sample.
@@ -219,10 +219,12 @@ impl Problem {
                 } = Launch::get(params, i);
                 ws.flights[i].reset(
                     &o.mass,
-                    o.position,
-                    o.orientation,
-                    v,
-                    w,
+                    LaunchState {
+                        origin: o.position,
+                        orientation: o.orientation,
+                        velocity: v,
+                        angular_velocity: w,
+                    },
                     scene.gravity,
                     scene.t,
                     &self.flight,
@@ -389,9 +391,11 @@ impl Problem {
                 Shape::Mesh(mesh) if self.silhouettes[i].is_some() => cam.rasterize_mesh(
                     p,
                     q,
-                    &mesh.vertices,
-                    &mesh.triangles,
-                    self.silhouettes[i].as_ref().expect("checked"),
+                    ClosedMesh {
+                        vertices: &mesh.vertices,
+                        triangles: &mesh.triangles,
+                        silhouette: self.silhouettes[i].as_ref().expect("checked"),
+                    },
                     &mut ws.world_vertices,
                     &mut ws.mask,
                     &mut ws.raster,

@@ -35,12 +35,19 @@ fn every_crate_path_points_to_the_same_or_a_lower_layer() {
     let mut wrong = Vec::new();
     for file in &files {
         let rel = file.strip_prefix(&src).unwrap();
-        let top = rel.components().next().unwrap().as_os_str().to_str().unwrap();
+        let top = rel
+            .components()
+            .next()
+            .unwrap()
+            .as_os_str()
+            .to_str()
+            .unwrap();
         let top = top.trim_end_matches(".rs");
         if top == "main" || top == "lib" || file.file_name().unwrap() == "tests.rs" {
             continue;
         }
-        let own = rank(top).unwrap_or_else(|| panic!("{}: module `{top}` has no layer", rel.display()));
+        let own =
+            rank(top).unwrap_or_else(|| panic!("{}: module `{top}` has no layer", rel.display()));
         let text = std::fs::read_to_string(file).unwrap();
         for (n, line) in text.lines().enumerate() {
             if line.trim_start().starts_with("#[cfg(test)]") {
@@ -60,6 +67,13 @@ fn every_crate_path_points_to_the_same_or_a_lower_layer() {
             }
         }
     }
-    assert!(seen > 50, "only {seen} crate paths found: is this the right folder?");
-    assert!(wrong.is_empty(), "paths that point up a layer:\n{}", wrong.join("\n"));
+    assert!(
+        seen > 50,
+        "only {seen} crate paths found: is this the right folder?"
+    );
+    assert!(
+        wrong.is_empty(),
+        "paths that point up a layer:\n{}",
+        wrong.join("\n")
+    );
 }

@@ -48,7 +48,7 @@ use crate::geometry::shape::Shape;
 use crate::output::solution::{check_solution, MismatchError, Solution};
 use crate::scene::Launch;
 use crate::sim::drag::{self, BodyDrag, DragConfig, DragError};
-use crate::sim::flight::FreeFlight;
+use crate::sim::flight::{FreeFlight, LaunchState};
 
 mod montecarlo;
 mod report;

@@ -228,10 +228,12 @@ impl<'a> Budget<'a> {
             Some(f) => {
                 f.reset(
                     &o.mass,
-                    o.position,
-                    o.orientation,
-                    v,
-                    w,
+                    LaunchState {
+                        origin: o.position,
+                        orientation: o.orientation,
+                        velocity: v,
+                        angular_velocity: w,
+                    },
                     scene.gravity,
                     tau.max(scene.t),
                     &self.problem.flight,

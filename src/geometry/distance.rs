@@ -200,30 +200,51 @@ pub fn signed_distance(
     qb: DQuat,
 ) -> f64 {
     signed_distance_warm(
-        sa,
-        pa,
-        qa,
-        sb,
-        pb,
-        qb,
+        PosedShape {
+            shape: sa,
+            position: pa,
+            orientation: qa,
+        },
+        PosedShape {
+            shape: sb,
+            position: pb,
+            orientation: qb,
+        },
         crate::geometry::gjk::REL_TOL,
         &mut Warm::default(),
     )
 }
 
+/// A contact shape at a pose (body -> world: `x -> position + orientation x`), as
+/// [`signed_distance_warm`] takes it.
+#[derive(Clone, Copy, Debug)]
+pub struct PosedShape<'a> {
+    /// The shape, in its body frame.
+    pub shape: &'a ContactShape,
+    /// Body-frame origin (m, world).
+    pub position: DVec3,
+    /// Body frame -> world.
+    pub orientation: DQuat,
+}
+
 /// [`signed_distance`] for a sequence of nearby poses of one pair: `warm` carries GJK's
 /// state from one query to the next (see [`crate::geometry::gjk::Warm`]).
-#[allow(clippy::too_many_arguments)]
 pub fn signed_distance_warm(
-    sa: &ContactShape,
-    pa: DVec3,
-    qa: DQuat,
-    sb: &ContactShape,
-    pb: DVec3,
-    qb: DQuat,
+    a: PosedShape<'_>,
+    b: PosedShape<'_>,
     rel_tol: f64,
     warm: &mut Warm,
 ) -> f64 {
+    let PosedShape {
+        shape: sa,
+        position: pa,
+        orientation: qa,
+    } = a;
+    let PosedShape {
+        shape: sb,
+        position: pb,
+        orientation: qb,
+    } = b;
     match (sa, sb) {
         (ContactShape::Ball(ra), ContactShape::Ball(rb)) => pa.distance(pb) - ra - rb,
         _ => {

@@ -15,7 +15,7 @@ use crate::geometry::distance::{
 };
 use crate::geometry::shape::{self, Shape, TriMesh};
 use crate::shadow::mask::Mask;
-use crate::shadow::raster::ShadowCamera;
+use crate::shadow::raster::{ImageRect, ShadowCamera};
 
 pub(super) struct Validator<'a> {
     pub(super) file: &'a Path,
@@ -98,13 +98,15 @@ impl Validator<'_> {
         let target = self.target(&raw.target)?;
         let camera = ShadowCamera::new(
             light,
-            receiver.center,
-            receiver.u,
-            receiver.v,
-            receiver.width,
-            receiver.height,
-            target.width(),
-            target.height(),
+            ImageRect {
+                center: receiver.center,
+                u: receiver.u,
+                v: receiver.v,
+                width_m: receiver.width,
+                height_m: receiver.height,
+                width_px: target.width(),
+                height_px: target.height(),
+            },
         );
         let table = match &raw.table {
             None => None,

@@ -166,7 +166,7 @@ pub fn simulate(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::flight::{FlightConfig, FreeFlight};
+    use crate::sim::flight::{FlightConfig, FreeFlight, LaunchState};
 
     fn scene_with(occluders: &str) -> Scene {
         let dir = std::env::temp_dir().join(format!(
@@ -211,10 +211,12 @@ mod tests {
             let mut f = FreeFlight::default();
             f.reset(
                 &o.mass,
-                o.position,
-                o.orientation,
-                v,
-                w,
+                LaunchState {
+                    origin: o.position,
+                    orientation: o.orientation,
+                    velocity: v,
+                    angular_velocity: w,
+                },
                 scene.gravity,
                 scene.t,
                 &FlightConfig::default(),
