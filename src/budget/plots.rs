@@ -7,7 +7,7 @@
 use image::{Rgb, RgbImage};
 
 use super::{BudgetReport, CurvePoint, SingleTolerance};
-use crate::output::picture::{self, Series};
+use crate::output::picture::{self, Chart, Series};
 
 /// Size of the histogram, in pixels.
 const HISTOGRAM_SIZE: (u32, u32) = (640, 400);
@@ -20,21 +20,21 @@ const GREEN: Rgb<u8> = Rgb([44, 160, 44]);
 /// The histogram of the Monte Carlo IoUs, with the IoU threshold marked in red.
 pub fn histogram(r: &BudgetReport) -> RgbImage {
     let h = &r.histogram;
-    picture::histogram_plot(
-        &format!("{}: IoU at t, {} samples", r.scene, r.monte_carlo.samples),
-        &format!(
-            "IoU (red: {}; P(IoU >= {}) = {:.1} %)",
-            r.iou_threshold,
-            r.iou_threshold,
-            100.0 * r.monte_carlo.p_iou_at_least_threshold
-        ),
-        h.lo,
-        h.hi,
-        &h.counts,
-        Some(r.iou_threshold),
-        HISTOGRAM_SIZE.0,
-        HISTOGRAM_SIZE.1,
-    )
+    let title = format!("{}: IoU at t, {} samples", r.scene, r.monte_carlo.samples);
+    let x_label = format!(
+        "IoU (red: {}; P(IoU >= {}) = {:.1} %)",
+        r.iou_threshold,
+        r.iou_threshold,
+        100.0 * r.monte_carlo.p_iou_at_least_threshold
+    );
+    let chart = Chart {
+        title: &title,
+        x_label: &x_label,
+        y_label: "samples",
+        width: HISTOGRAM_SIZE.0,
+        height: HISTOGRAM_SIZE.1,
+    };
+    picture::histogram_plot(&chart, (h.lo, h.hi), &h.counts, Some(r.iou_threshold))
 }
 
 /// The tolerance curves side by side, one panel per launch error, each with its
@@ -54,10 +54,17 @@ pub fn tolerances(r: &BudgetReport) -> Option<RgbImage> {
 /// alone.
 fn tolerance_panel(p: &SingleTolerance, threshold: f64) -> RgbImage {
     let pts = |f: &dyn Fn(&CurvePoint) -> f64| p.curve.iter().map(|c| (c.size, f(c))).collect();
+    let title = format!("{} error alone", p.parameter);
+    let x_label = format!("1 sigma ({})", p.unit);
+    let chart = Chart {
+        title: &title,
+        x_label: &x_label,
+        y_label: "IoU / probability",
+        width: PANEL_SIZE.0,
+        height: PANEL_SIZE.1,
+    };
     picture::line_plot(
-        &format!("{} error alone", p.parameter),
-        &format!("1 sigma ({})", p.unit),
-        "IoU / probability",
+        &chart,
         &[
             Series {
                 name: "mean IoU".into(),
@@ -77,7 +84,5 @@ fn tolerance_panel(p: &SingleTolerance, threshold: f64) -> RgbImage {
         ],
         (0.0, 1.0),
         Some(p.largest),
-        PANEL_SIZE.0,
-        PANEL_SIZE.1,
     )
 }

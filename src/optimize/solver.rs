@@ -296,17 +296,14 @@ pub fn solve(
             wall_time_s: stage_start.elapsed().as_secs_f64(),
         });
         let wall = prior_time + start.elapsed().as_secs_f64();
-        let s = summarize(
-            problem,
+        let run = Run {
             seed,
-            &params,
-            if stopped { k } else { k + 1 },
-            &reports,
-            wall,
+            stages_completed: if stopped { k } else { k + 1 },
+            complete: false,
+            wall_time_s: wall,
             threads,
-            false,
-            None,
-        );
+        };
+        let s = summarize(problem, &params, &reports, &run, None);
         observer.stage_finished(&s, &records);
         if stopped {
             aborted = true;
@@ -327,33 +324,43 @@ pub fn solve(
         && reports.iter().all(|r| !r.stop.starts_with("interrupted"));
     let mut ws = problem.workspace();
     let timing = problem.profile(&params, 200, &mut ws);
-    let s = summarize(
-        problem,
+    let run = Run {
         seed,
-        &params,
-        completed,
-        &reports,
-        wall,
-        threads,
+        stages_completed: completed,
         complete,
-        Some(timing),
-    );
+        wall_time_s: wall,
+        threads,
+    };
+    let s = summarize(problem, &params, &reports, &run, Some(timing));
     (s, records)
 }
 
-/// Build a [`Solution`] for the launch values `params`.
-#[allow(clippy::too_many_arguments)]
+/// How far a solve got, as [`summarize`] records it.
+#[derive(Clone, Copy, Debug)]
+pub struct Run {
+    pub seed: u64,
+    pub stages_completed: usize,
+    /// True when every stage ran to its own stop (not cut short by Ctrl-C).
+    pub complete: bool,
+    pub wall_time_s: f64,
+    pub threads: usize,
+}
+
+/// Build a [`Solution`] for the launch values `params` after the stages `reports`.
 pub fn summarize(
     problem: &Problem,
-    seed: u64,
     params: &[f64],
-    stages_completed: usize,
     reports: &[StageReport],
-    wall_time_s: f64,
-    threads: usize,
-    complete: bool,
+    run: &Run,
     timing: Option<Vec<(String, f64)>>,
 ) -> Solution {
+    let Run {
+        seed,
+        stages_completed,
+        complete,
+        wall_time_s,
+        threads,
+    } = *run;
     let scene = &problem.scene;
     let mut ws = problem.workspace();
     let all = problem.evaluate(params, &Weights::all_ones(), &mut ws);

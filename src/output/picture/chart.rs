@@ -157,26 +157,38 @@ pub(super) fn linear_frame(
     (img, ax)
 }
 
+/// A chart's title, axis labels and size in pixels.
+#[derive(Clone, Copy, Debug)]
+pub struct Chart<'a> {
+    pub title: &'a str,
+    pub x_label: &'a str,
+    pub y_label: &'a str,
+    pub width: u32,
+    pub height: u32,
+}
+
 /// Histogram of `counts` over equal bins from `lo` to `hi`, with an optional vertical
 /// marker (e.g. the IoU threshold) in red.
-#[allow(clippy::too_many_arguments)]
 pub fn histogram_plot(
-    title: &str,
-    x_label: &str,
-    lo: f64,
-    hi: f64,
+    chart: &Chart,
+    (lo, hi): (f64, f64),
     counts: &[usize],
     marker: Option<f64>,
-    width: u32,
-    height: u32,
 ) -> RgbImage {
+    let Chart {
+        title,
+        x_label,
+        y_label,
+        width,
+        height,
+    } = *chart;
     let top = counts.iter().copied().max().unwrap_or(0).max(1) as f64;
     let (mut img, ax) = linear_frame(
         width,
         height,
         title,
         x_label,
-        "samples",
+        y_label,
         (lo, hi),
         (0.0, top * 1.05),
     );
@@ -221,17 +233,14 @@ pub fn histogram_plot(
 
 /// Line plot of `series` on linear axes (`x` range from the data, `y` range given),
 /// with a legend in the lower left and an optional vertical marker in grey.
-#[allow(clippy::too_many_arguments)]
-pub fn line_plot(
-    title: &str,
-    x_label: &str,
-    y_label: &str,
-    series: &[Series],
-    y: (f64, f64),
-    marker: Option<f64>,
-    width: u32,
-    height: u32,
-) -> RgbImage {
+pub fn line_plot(chart: &Chart, series: &[Series], y: (f64, f64), marker: Option<f64>) -> RgbImage {
+    let Chart {
+        title,
+        x_label,
+        y_label,
+        width,
+        height,
+    } = *chart;
     let xs = series
         .iter()
         .flat_map(|s| s.points.iter().map(|p| p.0))
