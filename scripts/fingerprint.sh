@@ -20,6 +20,9 @@ seeds=("$@")
 mkdir -p "$out"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+# clap prints the binary's file name in its usage lines: call it `bsa` whatever its path.
+ln -s "$bin" "$work/bsa"
+bin=$work/bsa
 
 "$bin" --help >"$out/help.txt"
 for sub in check solve eval export validate video budget; do
