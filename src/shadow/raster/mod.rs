@@ -21,16 +21,18 @@
 //! the four planes through the light and the image edges), then scan-converted per row.
 //!
 //! Files: `camera.rs` (the camera, projection and clipping), `sphere.rs` (the sphere's
-//! conics), `scan.rs` (scan conversion, boxes and triangle meshes), `silhouette.rs` (the
+//! conics), `rows.rs` (row spans and the scratch buffers they all share), `scan.rs` (scan
+//! conversion, boxes and triangle meshes), `silhouette.rs` (the
 //! silhouette path for closed meshes).
 
 mod camera;
+mod rows;
 mod scan;
 mod silhouette;
 mod sphere;
 
 pub use camera::{ImageRect, ShadowCamera};
-pub use scan::RasterScratch;
+pub use rows::RasterScratch;
 pub use silhouette::{ClosedMesh, MeshSilhouette};
 
 #[cfg(test)]

@@ -3,20 +3,9 @@
 //! silhouette edges with the non-zero winding rule.
 
 use super::camera::ShadowCamera;
-use super::scan::RasterScratch;
+use super::rows::{RasterScratch, SilEdge};
 use crate::shadow::mask::Mask;
 use glam::{DQuat, DVec2, DVec3};
-
-/// A silhouette edge in pixel space: its upper end, slope dx/dy, the rows whose centre
-/// lines it crosses, and its winding direction.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct SilEdge {
-    top: DVec2,
-    slope: f64,
-    j0: u32,
-    j1: u32,
-    dir: i32,
-}
 
 /// What the silhouette path precomputes for a closed, consistently oriented mesh: one
 /// plane per triangle and, for every edge, its two faces.

@@ -3,57 +3,9 @@
 //! sections bound the shadow.
 
 use super::camera::ShadowCamera;
-use super::scan::{centre_span, fill_rows};
+use super::rows::{centre_span, fill_rows, Iv};
 use crate::shadow::mask::Mask;
 use glam::DVec3;
-
-/// A closed interval `[lo, hi]`; empty when `!(lo <= hi)` (this also catches NaN).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Iv {
-    pub(super) lo: f64,
-    pub(super) hi: f64,
-}
-
-impl Iv {
-    const EMPTY: Iv = Iv {
-        lo: f64::INFINITY,
-        hi: f64::NEG_INFINITY,
-    };
-    const ALL: Iv = Iv {
-        lo: f64::NEG_INFINITY,
-        hi: f64::INFINITY,
-    };
-
-    #[inline]
-    pub(super) fn new(lo: f64, hi: f64) -> Iv {
-        Iv { lo, hi }
-    }
-
-    #[inline]
-    pub(super) fn is_empty(self) -> bool {
-        // Written with partial_cmp so that NaN bounds count as empty.
-        !matches!(
-            self.lo.partial_cmp(&self.hi),
-            Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)
-        )
-    }
-
-    #[inline]
-    fn meet(self, o: Iv) -> Iv {
-        Iv::new(self.lo.max(o.lo), self.hi.min(o.hi))
-    }
-
-    /// The smallest interval containing both; used to merge pieces whose union is known
-    /// to be an interval (the shadow of a convex body on a line is convex).
-    #[inline]
-    fn hull(self, o: Iv) -> Iv {
-        match (self.is_empty(), o.is_empty()) {
-            (true, _) => o,
-            (_, true) => self,
-            _ => Iv::new(self.lo.min(o.lo), self.hi.max(o.hi)),
-        }
-    }
-}
 
 /// Sorted real roots of `a s^2 + b s + c` (a != 0), or `None` if there are none. Uses the
 /// cancellation-free form, so a tiny `a` yields one accurate root and one huge root.
