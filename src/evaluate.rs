@@ -213,18 +213,9 @@ impl Problem {
         let scene = &self.scene;
         for (i, o) in scene.occluders.iter().enumerate() {
             if o.launched {
-                let Launch {
-                    velocity: v,
-                    angular_velocity: w,
-                } = Launch::get(params, i);
                 ws.flights[i].reset(
                     &o.mass,
-                    LaunchState {
-                        origin: o.position,
-                        orientation: o.orientation,
-                        velocity: v,
-                        angular_velocity: w,
-                    },
+                    LaunchState::of(o, Launch::get(params, i)),
                     scene.gravity,
                     scene.t,
                     &self.flight,

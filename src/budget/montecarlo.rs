@@ -228,12 +228,13 @@ impl<'a> Budget<'a> {
             Some(f) => {
                 f.reset(
                     &o.mass,
-                    LaunchState {
-                        origin: o.position,
-                        orientation: o.orientation,
-                        velocity: v,
-                        angular_velocity: w,
-                    },
+                    LaunchState::of(
+                        o,
+                        Launch {
+                            velocity: v,
+                            angular_velocity: w,
+                        },
+                    ),
                     scene.gravity,
                     tau.max(scene.t),
                     &self.problem.flight,

@@ -166,6 +166,7 @@ pub fn simulate(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::Launch;
     use crate::sim::flight::{FlightConfig, FreeFlight, LaunchState};
 
     fn scene_with(occluders: &str) -> Scene {
@@ -211,12 +212,13 @@ mod tests {
             let mut f = FreeFlight::default();
             f.reset(
                 &o.mass,
-                LaunchState {
-                    origin: o.position,
-                    orientation: o.orientation,
-                    velocity: v,
-                    angular_velocity: w,
-                },
+                LaunchState::of(
+                    o,
+                    Launch {
+                        velocity: v,
+                        angular_velocity: w,
+                    },
+                ),
                 scene.gravity,
                 scene.t,
                 &FlightConfig::default(),

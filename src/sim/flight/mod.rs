@@ -21,6 +21,7 @@
 use glam::{DQuat, DVec3};
 
 use crate::geometry::shape::MassProperties;
+use crate::scene::{Launch, Occluder};
 
 /// Relative tolerance under which two principal moments count as equal, so that the
 /// closed-form isotropic or axisymmetric rotation is used. At 1e-9 the closed form's
@@ -97,6 +98,18 @@ pub struct LaunchState {
     pub velocity: DVec3,
     /// Angular velocity (rad/s, world).
     pub angular_velocity: DVec3,
+}
+
+impl LaunchState {
+    /// Occluder `o` launched from its scene pose with the velocities `launch`.
+    pub fn of(o: &Occluder, launch: Launch) -> LaunchState {
+        LaunchState {
+            origin: o.position,
+            orientation: o.orientation,
+            velocity: launch.velocity,
+            angular_velocity: launch.angular_velocity,
+        }
+    }
 }
 
 /// Which rotation law [`FreeFlight`] uses, chosen from the principal moments at reset
