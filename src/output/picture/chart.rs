@@ -70,15 +70,14 @@ impl LinearAxes {
     }
 }
 
-pub(super) fn linear_frame(
-    width: u32,
-    height: u32,
-    title: &str,
-    x_label: &str,
-    y_label: &str,
-    x: (f64, f64),
-    y: (f64, f64),
-) -> (RgbImage, LinearAxes) {
+pub(super) fn linear_frame(chart: &Chart, x: (f64, f64), y: (f64, f64)) -> (RgbImage, LinearAxes) {
+    let Chart {
+        title,
+        x_label,
+        y_label,
+        width,
+        height,
+    } = *chart;
     let mut img = RgbImage::from_pixel(width, height, WHITE);
     let s = (width.min(height * 4 / 3) / 230).clamp(1, 4);
     let si = s as i32;
@@ -175,23 +174,8 @@ pub fn histogram_plot(
     counts: &[usize],
     marker: Option<f64>,
 ) -> RgbImage {
-    let Chart {
-        title,
-        x_label,
-        y_label,
-        width,
-        height,
-    } = *chart;
     let top = counts.iter().copied().max().unwrap_or(0).max(1) as f64;
-    let (mut img, ax) = linear_frame(
-        width,
-        height,
-        title,
-        x_label,
-        y_label,
-        (lo, hi),
-        (0.0, top * 1.05),
-    );
+    let (mut img, ax) = linear_frame(chart, (lo, hi), (0.0, top * 1.05));
     let n = counts.len().max(1);
     for (k, &c) in counts.iter().enumerate() {
         let x0 = ax.px(lo + (hi - lo) * k as f64 / n as f64);
@@ -234,13 +218,6 @@ pub fn histogram_plot(
 /// Line plot of `series` on linear axes (`x` range from the data, `y` range given),
 /// with a legend in the lower left and an optional vertical marker in grey.
 pub fn line_plot(chart: &Chart, series: &[Series], y: (f64, f64), marker: Option<f64>) -> RgbImage {
-    let Chart {
-        title,
-        x_label,
-        y_label,
-        width,
-        height,
-    } = *chart;
     let xs = series
         .iter()
         .flat_map(|s| s.points.iter().map(|p| p.0))
@@ -255,7 +232,7 @@ pub fn line_plot(chart: &Chart, series: &[Series], y: (f64, f64), marker: Option
     } else {
         (0.0, 1.0)
     };
-    let (mut img, ax) = linear_frame(width, height, title, x_label, y_label, x, y);
+    let (mut img, ax) = linear_frame(chart, x, y);
     if let Some(m) = marker.filter(|m| m.is_finite() && *m >= x.0 && *m <= x.1) {
         let px = ax.px(m);
         line(&mut img, (px, ax.top), (px, ax.bottom), FRAME, 1);
@@ -282,7 +259,7 @@ pub fn line_plot(chart: &Chart, series: &[Series], y: (f64, f64), marker: Option
         FRAME,
     );
     // Legend in the lower-left corner.
-    let sc = (width.min(height * 4 / 3) / 230).clamp(1, 4);
+    let sc = (chart.width.min(chart.height * 4 / 3) / 230).clamp(1, 4);
     let si = sc as i32;
     let th = text_height(sc) as i32;
     let line_h = th + 2 * si;
