@@ -617,5 +617,7 @@ impl Cmaes {
     }
 }
 
+pub mod functions;
+
 #[cfg(test)]
 mod tests;
