@@ -64,6 +64,8 @@ pub struct Workspace {
     landing: Vec<Option<f64>>,
     /// Time of each body's first table contact (a landing or sinking in), if before t.
     table_hit: Vec<Option<f64>>,
+    /// Times of the pair contacts found in the last sample (room for every pair).
+    pair_hits: Vec<f64>,
 }
 
 impl Workspace {
@@ -117,7 +119,91 @@ impl Evaluation {
     }
 }
 
+/// Whether occluder `i` is in the set `which` (everything is in `None`).
+fn among(which: Option<&[bool]>, i: usize) -> bool {
+    which.is_none_or(|w| w[i])
+}
+
+/// What a stage holds fixed, computed once per stage by [`Problem::hold`] so that a
+/// sample pays only for what varies ([`Problem::evaluate_held`]): the held occluders'
+/// flights, table contacts and poses at `t`, every contact between two of them before
+/// `t`, and their shadow.
+pub struct Held {
+    /// The launch values the held occluders keep.
+    base: Vec<f64>,
+    /// Whether each occluder varies (is computed per sample).
+    varying: Vec<bool>,
+    /// Flights of the held launched occluders (the varying ones' are unused).
+    flights: Vec<FreeFlight>,
+    poses: Vec<(DVec3, DQuat)>,
+    landing: Vec<Option<f64>>,
+    table_hit: Vec<Option<f64>>,
+    /// Every contact between two held occluders up to `t`: (time, order key, i, j).
+    pair_hits: Vec<(f64, usize, usize, usize)>,
+    /// The held occluders' shadow at `t`.
+    mask: Mask,
+}
+
+impl Held {
+    /// The launch values of every occluder that the held ones keep (6 per occluder).
+    pub fn base(&self) -> &[f64] {
+        &self.base
+    }
+}
+
 impl Problem {
+    /// The fixed part of the samples that change only the occluders in `vary`, the
+    /// others keeping their launch values in `base`. If `base` holds a value that makes
+    /// every sample diverge (non-finite, spinning too fast), nothing is computed: such a
+    /// sample is caught before anything held is used.
+    pub fn hold(&self, base: &[f64], vary: &[usize]) -> Held {
+        let scene = &self.scene;
+        let n = scene.occluders.len();
+        let mut varying = vec![false; n];
+        for &i in vary {
+            varying[i] = true;
+        }
+        let mut ws = self.workspace();
+        let mut held = Held {
+            base: base.to_vec(),
+            varying,
+            flights: Vec::new(),
+            poses: vec![(DVec3::ZERO, DQuat::IDENTITY); n],
+            landing: vec![None; n],
+            table_hit: vec![None; n],
+            pair_hits: Vec::new(),
+            mask: ws.mask.clone(),
+        };
+        if base.iter().any(|x| !x.is_finite()) || self.spins_too_fast(base) {
+            return held;
+        }
+        let kept: Vec<bool> = held.varying.iter().map(|v| !v).collect();
+        self.launch(Some(&kept), base, &mut ws);
+        let mut key = n;
+        for i in 0..n {
+            if !held.varying[i] {
+                (held.landing[i], held.table_hit[i]) = self.table_contact(i, &ws.flights);
+                ws.landing[i] = held.landing[i];
+                held.poses[i] = self.state_at(&ws, i, scene.t).0;
+                ws.poses[i] = held.poses[i];
+            }
+            for j in (i + 1)..n {
+                key += 1;
+                let both_fixed = !scene.occluders[i].launched && !scene.occluders[j].launched;
+                if held.varying[i] || held.varying[j] || both_fixed {
+                    continue;
+                }
+                if let Some(tc) = self.pair_contact(i, &ws.flights, j, &ws.flights, scene.t) {
+                    held.pair_hits.push((tc, key - 1, i, j));
+                }
+            }
+        }
+        self.shadow_with(None, Some(&kept), &mut ws);
+        held.mask = ws.mask.clone();
+        held.flights = std::mem::take(&mut ws.flights);
+        held
+    }
+
     pub fn new(scene: Scene) -> Problem {
         let target = TargetData::new(&scene.target);
         let shapes = scene
@@ -175,18 +261,49 @@ impl Problem {
             poses: vec![(DVec3::ZERO, DQuat::IDENTITY); n],
             landing: vec![None; n],
             table_hit: vec![None; n],
+            pair_hits: Vec::with_capacity(n * n.saturating_sub(1) / 2),
         }
     }
 
     /// Evaluate one sample. `params` holds 6 values per occluder (`v` then `w`); values of
     /// non-launched occluders are ignored. Terms with weight 0 are skipped.
     pub fn evaluate(&self, params: &[f64], weights: &Weights, ws: &mut Workspace) -> Evaluation {
+        self.evaluate_sample(None, params, weights, ws)
+    }
+
+    /// [`Problem::evaluate`] of a sample that differs from `held`'s base only in the
+    /// occluders `held` lets vary: the held occluders' flights, contacts among them, poses
+    /// and shadow come from `held`, so only the varying ones are flown, checked and drawn.
+    /// The result is the same, bit for bit, as `evaluate` on the same `params`.
+    pub fn evaluate_held(
+        &self,
+        held: &Held,
+        params: &[f64],
+        weights: &Weights,
+        ws: &mut Workspace,
+    ) -> Evaluation {
+        debug_assert!(
+            (0..self.scene.occluders.len())
+                .filter(|&i| !held.varying[i])
+                .all(|i| Launch::get(params, i) == Launch::get(&held.base, i)),
+            "a held occluder's launch values differ from the held base"
+        );
+        self.evaluate_sample(Some(held), params, weights, ws)
+    }
+
+    fn evaluate_sample(
+        &self,
+        held: Option<&Held>,
+        params: &[f64],
+        weights: &Weights,
+        ws: &mut Workspace,
+    ) -> Evaluation {
         debug_assert_eq!(params.len(), self.scene.variable_count());
         if params.iter().any(|x| !x.is_finite()) || self.spins_too_fast(params) {
             return Evaluation::diverged();
         }
-        let outcome = self.fly(params, ws);
-        self.shadow(ws);
+        let outcome = self.fly_with(held, params, ws);
+        self.shadow_with(held.map(|h| &h.mask), held.map(|h| &h.varying[..]), ws);
         let mut raw = [0.0; TERM_COUNT];
         energy::image_terms(&self.target, &ws.mask, weights, &mut raw);
         self.physics_and_scene_terms(params, &outcome, ws, &mut raw);
@@ -208,11 +325,11 @@ impl Problem {
         })
     }
 
-    /// Step 1: start the exact free flight of every launched body.
-    fn launch(&self, params: &[f64], ws: &mut Workspace) {
+    /// Step 1: start the exact free flight of every launched body (that varies).
+    fn launch(&self, which: Option<&[bool]>, params: &[f64], ws: &mut Workspace) {
         let scene = &self.scene;
         for (i, o) in scene.occluders.iter().enumerate() {
-            if o.launched {
+            if o.launched && among(which, i) {
                 ws.flights[i].reset(
                     &o.mass,
                     LaunchState::of(o, Launch::get(params, i)),
@@ -226,12 +343,19 @@ impl Problem {
 
     /// Steps 1-3: flights, first contact, poses at `t` (into `ws.poses`).
     pub fn fly(&self, params: &[f64], ws: &mut Workspace) -> Outcome {
+        self.fly_with(None, params, ws)
+    }
+
+    fn fly_with(&self, held: Option<&Held>, params: &[f64], ws: &mut Workspace) -> Outcome {
         let scene = &self.scene;
         let t = scene.t;
-        self.launch(params, ws);
-        let outcome = self.first_contact(ws);
+        self.launch(held.map(|h| &h.varying[..]), params, ws);
+        let outcome = self.first_contact(held, ws);
         for i in 0..scene.occluders.len() {
-            ws.poses[i] = self.state_at(ws, i, t).0;
+            ws.poses[i] = match held {
+                Some(h) if !h.varying[i] => h.poses[i],
+                _ => self.state_at(ws, i, t).0,
+            };
         }
         outcome
     }
@@ -264,10 +388,11 @@ impl Problem {
         ((com - q * o.mass.local_com, q), (v, w))
     }
 
-    fn motion<'a>(&self, i: usize, ws: &'a Workspace) -> Motion<'a> {
+    /// Occluder `i`'s motion: its flight in `flights` if launched, else its launch pose.
+    fn motion<'a>(&self, i: usize, flights: &'a [FreeFlight]) -> Motion<'a> {
         let o = &self.scene.occluders[i];
         if o.launched {
-            Motion::Flying(&ws.flights[i])
+            Motion::Flying(&flights[i])
         } else {
             Motion::Fixed {
                 origin: o.position,
@@ -277,72 +402,67 @@ impl Problem {
         }
     }
 
-    fn first_contact(&self, ws: &mut Workspace) -> Outcome {
+    /// Step 2: the first contact before `t`. Every contact is given an order key (table
+    /// contacts by occluder, then pairs in `(i, j)` order) and the first is the least
+    /// (time, key): a plain scan in key order, which is also what makes the held
+    /// occluders' cached contacts combine with the varying ones' to the same answer.
+    /// A pair is only searched up to the best time so far (plus the simultaneity window):
+    /// every contact that can change the outcome is still found, whatever the order.
+    fn first_contact(&self, held: Option<&Held>, ws: &mut Workspace) -> Outcome {
         let scene = &self.scene;
         let t = scene.t;
         let n = scene.occluders.len();
-        let mut best = f64::INFINITY;
+        let mut best = (f64::INFINITY, usize::MAX);
         let mut first = None;
         // Landings are needed for every body (they decide its pose at t), so they are
         // searched over the whole flight.
         for i in 0..n {
-            ws.landing[i] = None;
-            ws.table_hit[i] = None;
-            if !scene.occluders[i].launched {
-                continue;
-            }
-            if let (Some(table), Some(ts)) = (&scene.table, &self.table_shape) {
-                let body = Body {
-                    motion: self.motion(i, ws),
-                    shape: &self.shapes[i],
-                    radius: scene.occluders[i].bounding_radius,
-                };
-                let c = contact::table_contact(&body, table, ts, t);
-                // Only a real landing stops the body; sinking into the table before
-                // leaving it (a spinning box tipping a corner in) costs a contact, but the
-                // body flies on, so its launch speed still shapes its shadow at t.
-                ws.landing[i] = c.filter(|c| c.landed).map(|c| c.time);
-                ws.table_hit[i] = c.map(|c| c.time);
-                if let Some(c) = c {
-                    if c.time < best {
-                        best = c.time;
-                        first = Some((i, None));
-                    }
+            let c = match held {
+                Some(h) if !h.varying[i] => (h.landing[i], h.table_hit[i]),
+                _ => self.table_contact(i, &ws.flights),
+            };
+            (ws.landing[i], ws.table_hit[i]) = c;
+            if let Some(time) = ws.table_hit[i] {
+                if (time, i) < best {
+                    best = (time, i);
+                    first = Some((i, None));
                 }
             }
         }
-        let mut pair_times = 0u32;
-        let mut pair_hits: [f64; 64] = [f64::INFINITY; 64];
+        ws.pair_hits.clear();
+        if let Some(h) = held {
+            for &(tc, key, i, j) in &h.pair_hits {
+                ws.pair_hits.push(tc);
+                if (tc, key) < best {
+                    best = (tc, key);
+                    first = Some((i, Some(j)));
+                }
+            }
+        }
+        let mut key = n;
         for i in 0..n {
             for j in (i + 1)..n {
-                if !scene.occluders[i].launched && !scene.occluders[j].launched {
+                key += 1;
+                if !scene.occluders[i].launched && !scene.occluders[j].launched
+                    || held.is_some_and(|h| !h.varying[i] && !h.varying[j])
+                {
                     continue;
                 }
-                // Only contacts before the best so far (plus the simultaneity window)
-                // can change the outcome, so later ones are not searched for.
-                let horizon = t.min(best + SIMULTANEOUS);
-                let a = Body {
-                    motion: self.motion(i, ws),
-                    shape: &self.shapes[i],
-                    radius: scene.occluders[i].bounding_radius,
+                let horizon = t.min(best.0 + SIMULTANEOUS);
+                let flights_of = |k: usize| match held {
+                    Some(h) if !h.varying[k] => &h.flights[..],
+                    _ => &ws.flights[..],
                 };
-                let b = Body {
-                    motion: self.motion(j, ws),
-                    shape: &self.shapes[j],
-                    radius: scene.occluders[j].bounding_radius,
-                };
-                if let Some(tc) = contact::pair_contact_time(&a, &b, horizon) {
-                    if (pair_times as usize) < pair_hits.len() {
-                        pair_hits[pair_times as usize] = tc;
-                    }
-                    pair_times += 1;
-                    if tc < best {
-                        best = tc;
+                if let Some(tc) = self.pair_contact(i, flights_of(i), j, flights_of(j), horizon) {
+                    ws.pair_hits.push(tc);
+                    if (tc, key - 1) < best {
+                        best = (tc, key - 1);
                         first = Some((i, Some(j)));
                     }
                 }
             }
         }
+        let best = best.0;
         if best >= t {
             return Outcome {
                 t_sim: t,
@@ -351,28 +471,82 @@ impl Problem {
             };
         }
         let cut = best + SIMULTANEOUS;
-        let mut count = ws
+        let count = ws
             .table_hit
             .iter()
             .flatten()
             .filter(|&&tl| tl <= cut)
-            .count() as u32;
-        count += pair_hits.iter().filter(|&&tc| tc <= cut).count() as u32;
-        // More than 64 pair hits within one horizon is not realistic; count the overflow
-        // as simultaneous, which only raises the penalty.
-        count += pair_times.saturating_sub(pair_hits.len() as u32);
+            .count()
+            + ws.pair_hits.iter().filter(|&&tc| tc <= cut).count();
         Outcome {
             t_sim: best,
-            n_contacts: count.max(1),
+            n_contacts: (count as u32).max(1),
             first_contact: first,
         }
     }
 
+    /// Occluder `i`'s first table contact over the flight to `t`: (its landing, its first
+    /// table contact). Only a real landing stops the body; sinking into the table before
+    /// leaving it (a spinning box tipping a corner in) costs a contact, but the body flies
+    /// on, so its launch speed still shapes its shadow at t.
+    fn table_contact(&self, i: usize, flights: &[FreeFlight]) -> (Option<f64>, Option<f64>) {
+        let scene = &self.scene;
+        let (Some(table), Some(ts)) = (&scene.table, &self.table_shape) else {
+            return (None, None);
+        };
+        if !scene.occluders[i].launched {
+            return (None, None);
+        }
+        let body = Body {
+            motion: self.motion(i, flights),
+            shape: &self.shapes[i],
+            radius: scene.occluders[i].bounding_radius,
+        };
+        let c = contact::table_contact(&body, table, ts, scene.t);
+        (c.filter(|c| c.landed).map(|c| c.time), c.map(|c| c.time))
+    }
+
+    /// First contact of occluders `i` and `j` (their flights in `fi` and `fj`) up to
+    /// `horizon`.
+    fn pair_contact(
+        &self,
+        i: usize,
+        fi: &[FreeFlight],
+        j: usize,
+        fj: &[FreeFlight],
+        horizon: f64,
+    ) -> Option<f64> {
+        let occ = &self.scene.occluders;
+        let a = Body {
+            motion: self.motion(i, fi),
+            shape: &self.shapes[i],
+            radius: occ[i].bounding_radius,
+        };
+        let b = Body {
+            motion: self.motion(j, fj),
+            shape: &self.shapes[j],
+            radius: occ[j].bounding_radius,
+        };
+        contact::pair_contact_time(&a, &b, horizon)
+    }
+
     /// Step 4: the shadow of every occluder at its pose in `ws.poses`, into `ws.mask`.
     pub fn shadow(&self, ws: &mut Workspace) {
+        self.shadow_with(None, None, ws)
+    }
+
+    /// [`Problem::shadow`] of the occluders in `which` only, drawn over `start` (a held
+    /// shadow; OR is order-free, so the mask is the same as drawing everything).
+    fn shadow_with(&self, start: Option<&Mask>, which: Option<&[bool]>, ws: &mut Workspace) {
         let cam = &self.scene.camera;
-        ws.mask.clear();
+        match start {
+            Some(m) => ws.mask.copy_from(m),
+            None => ws.mask.clear(),
+        }
         for (i, o) in self.scene.occluders.iter().enumerate() {
+            if !among(which, i) {
+                continue;
+            }
             let (p, q) = ws.poses[i];
             match &o.shape {
                 Shape::Sphere { radius } => cam.rasterize_sphere(p, *radius, &mut ws.mask),
@@ -506,10 +680,10 @@ impl Problem {
             }
             start.elapsed().as_secs_f64() * 1e6 / reps as f64
         };
-        let us = time(&mut || self.launch(params, ws));
+        let us = time(&mut || self.launch(None, params, ws));
         out.push(("flight".into(), us));
         let us = time(&mut || {
-            std::hint::black_box(self.first_contact(ws));
+            std::hint::black_box(self.first_contact(None, ws));
         });
         out.push(("contacts".into(), us));
         self.fly(params, ws);

@@ -37,8 +37,10 @@ pub(super) struct SolveProgress {
     target: crate::shadow::mask::Mask,
     /// The stage names, for the convergence table.
     pub(super) stage_names: Vec<String>,
-    /// The convergence records of the stages a resumed solve skips.
-    prior: Vec<SampleRecord>,
+    /// `convergence.csv` so far (a resumed solve's skipped stages included).
+    pub(super) csv: files::ConvergenceCsv,
+    /// How many of this run's records `csv` holds.
+    pub(super) encoded: usize,
     bar: Option<ProgressBar>,
     quiet: bool,
     last_preview: Instant,
@@ -51,21 +53,24 @@ impl SolveProgress {
     pub(super) fn new(
         out: PathBuf,
         scene: &Scene,
-        prior: Vec<SampleRecord>,
+        prior: &[SampleRecord],
         quiet: bool,
-    ) -> SolveProgress {
-        SolveProgress {
+    ) -> anyhow::Result<SolveProgress> {
+        let mut csv = files::ConvergenceCsv::new(&out);
+        csv.extend(prior)?;
+        Ok(SolveProgress {
             out,
             target: scene.target.clone(),
             stage_names: scene.stages.iter().map(|s| s.name.clone()).collect(),
-            prior,
+            csv,
+            encoded: 0,
             bar: None,
             quiet,
             // In the past, so that the first iteration already writes a preview.
             last_preview: Instant::now() - Duration::from_secs(1),
             stages_total: scene.stages.len(),
             error: None,
-        }
+        })
     }
 }
 
@@ -104,6 +109,7 @@ impl Observer for SolveProgress {
     }
 
     fn stage_finished(&mut self, s: &Solution, records: &[SampleRecord]) {
+        // `records` is every record of this run so far: only the new ones are encoded.
         if let Some(bar) = self.bar.take() {
             bar.finish_and_clear();
         }
@@ -113,10 +119,10 @@ impl Observer for SolveProgress {
                 s.stages_completed, s.stages_total, r.name, r.iterations, r.samples, r.best_energy, r.iou, r.wall_time_s, r.stop
             );
         }
-        let mut all = self.prior.clone();
-        all.extend_from_slice(records);
         let res = files::write_solution(&self.out, s)
-            .and_then(|_| files::write_convergence(&self.out, &self.stage_names, &all));
+            .and_then(|_| self.csv.extend(&records[self.encoded..]))
+            .and_then(|_| self.csv.write());
+        self.encoded = records.len();
         if let Err(e) = res {
             self.error.get_or_insert(e.into());
         }

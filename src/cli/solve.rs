@@ -102,7 +102,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         }
     })
     .context("cannot install the Ctrl-C handler")?;
-    let mut observer = SolveProgress::new(out.clone(), scene, prior.clone(), opts.quiet);
+    let mut observer = SolveProgress::new(out.clone(), scene, &prior, opts.quiet)?;
     // A resumed solve keeps the seed it was started with.
     let seed = resume_from.as_ref().map(|s| s.seed).or(opts.seed);
     let options = SolveOptions {
@@ -114,10 +114,13 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     if let Some(e) = observer.error.take() {
         return Err(e.context("while saving progress"));
     }
+    files::write_solution(&out, &solution)?;
+    // The table was saved after every stage; the plot is drawn once, at the end.
+    observer.csv.extend(&records[observer.encoded..])?;
+    observer.csv.write()?;
     let mut all = prior;
     all.extend(records);
-    files::write_solution(&out, &solution)?;
-    files::write_convergence(&out, &observer.stage_names, &all)?;
+    files::write_convergence_plot(&out, &observer.stage_names, &all)?;
     let mut ws = problem.workspace();
     let params = solution.parameters();
     problem.evaluate(&params, &Weights::all_ones(), &mut ws);

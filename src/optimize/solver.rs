@@ -27,7 +27,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::energy::{Term, Weights, TERM_COUNT};
-use crate::evaluate::{Evaluation, Problem, Workspace};
+use crate::evaluate::{Evaluation, Held, Problem, Workspace};
 use crate::optimize::cmaes::{Cmaes, CmaesConfig, StopReason};
 use crate::output::solution::{OccluderLaunch, SampleRecord, Solution, StageReport, TermValue};
 use crate::scene::{Launch, Stage};
@@ -97,12 +97,13 @@ impl Pool {
     fn evaluate(
         &self,
         problem: &Problem,
-        base: &[f64],
+        held: &Held,
         stage: &Stage,
         candidates: &[f64],
         n: usize,
         out: &mut [Evaluation],
     ) {
+        let base = held.base();
         let full = base.len();
         self.pool.install(|| {
             out.par_iter_mut().enumerate().for_each_init(
@@ -113,7 +114,7 @@ impl Pool {
                     let mut ws = self.workspaces[idx]
                         .lock()
                         .unwrap_or_else(|e| e.into_inner());
-                    *slot = problem.evaluate(params, &stage.weights, &mut ws);
+                    *slot = problem.evaluate_held(held, params, &stage.weights, &mut ws);
                 },
             );
         });
@@ -232,13 +233,15 @@ pub fn solve(
         let mut interrupted = false;
         let mut scratch = vec![0.0; params.len()];
         let mut candidates = vec![0.0; lambda * n];
+        // What the stage holds fixed, computed once: a sample only pays for what varies.
+        let held = problem.hold(&params, &stage.vary);
         let stop = loop {
             if interrupts.load(Ordering::SeqCst) > interrupts_at_start {
                 interrupted = true;
                 break None;
             }
             candidates.copy_from_slice(cma.ask());
-            pool.evaluate(problem, &params, stage, &candidates, n, &mut evals);
+            pool.evaluate(problem, &held, stage, &candidates, n, &mut evals);
             let mut improved = None;
             for (j, e) in evals.iter().enumerate() {
                 fitness[j] = e.total;

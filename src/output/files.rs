@@ -137,27 +137,74 @@ pub fn write_convergence(
     stage_names: &[String],
     records: &[SampleRecord],
 ) -> Result<()> {
-    let path = dir.join("convergence.csv");
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header = vec!["stage".to_string(), "iteration".to_string()];
-    header.extend(Term::ALL.iter().map(|t| t.key().to_string()));
-    header.push("total".into());
-    let enc = |e: csv::Error| ExportError::Encode {
-        path: path.clone(),
-        message: e.to_string(),
-    };
-    w.write_record(&header).map_err(enc)?;
-    for r in records {
-        let mut row = vec![r.stage.to_string(), r.iteration.to_string()];
-        row.extend(r.terms.iter().map(|x| format!("{x:e}")));
-        row.push(format!("{:e}", r.total));
-        w.write_record(&row).map_err(enc)?;
+    let mut csv = ConvergenceCsv::new(dir);
+    csv.extend(records)?;
+    csv.write()?;
+    write_convergence_plot(dir, stage_names, records)
+}
+
+/// `convergence.csv` kept as its encoded text, so that a solve that saves after every
+/// stage encodes each row once (and not the whole table again at every stage).
+pub struct ConvergenceCsv {
+    path: PathBuf,
+    bytes: Vec<u8>,
+}
+
+impl ConvergenceCsv {
+    /// The table with its header and no row yet, to be written in `dir`.
+    pub fn new(dir: &Path) -> ConvergenceCsv {
+        let mut header = vec!["stage".to_string(), "iteration".to_string()];
+        header.extend(Term::ALL.iter().map(|t| t.key().to_string()));
+        header.push("total".into());
+        let mut csv = ConvergenceCsv {
+            path: dir.join("convergence.csv"),
+            bytes: Vec::new(),
+        };
+        csv.encode(|w| w.write_record(&header))
+            .expect("encoding into memory cannot fail");
+        csv
     }
-    let bytes = w.into_inner().map_err(|e| ExportError::Encode {
-        path: path.clone(),
-        message: e.to_string(),
-    })?;
-    write_atomic(&path, &bytes)?;
+
+    /// Append rows.
+    pub fn extend(&mut self, records: &[SampleRecord]) -> Result<()> {
+        self.encode(|w| {
+            for r in records {
+                let mut row = vec![r.stage.to_string(), r.iteration.to_string()];
+                row.extend(r.terms.iter().map(|x| format!("{x:e}")));
+                row.push(format!("{:e}", r.total));
+                w.write_record(&row)?;
+            }
+            Ok(())
+        })
+    }
+
+    fn encode(
+        &mut self,
+        f: impl FnOnce(&mut csv::Writer<&mut Vec<u8>>) -> csv::Result<()>,
+    ) -> Result<()> {
+        let enc = |message: String| ExportError::Encode {
+            path: self.path.clone(),
+            message,
+        };
+        let mut w = csv::WriterBuilder::new()
+            .has_headers(false)
+            .from_writer(&mut self.bytes);
+        f(&mut w).map_err(|e| enc(e.to_string()))?;
+        w.flush().map_err(|e| enc(e.to_string()))
+    }
+
+    /// Write the table so far, atomically.
+    pub fn write(&self) -> Result<()> {
+        write_atomic(&self.path, &self.bytes)
+    }
+}
+
+/// `convergence.png`: one log-scale panel per stage.
+pub fn write_convergence_plot(
+    dir: &Path,
+    stage_names: &[String],
+    records: &[SampleRecord],
+) -> Result<()> {
     let data = picture::ConvergenceData {
         stage_names: stage_names.to_vec(),
         term_names: Term::ALL.iter().map(|t| t.label().to_string()).collect(),

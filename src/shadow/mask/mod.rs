@@ -201,6 +201,20 @@ impl Mask {
         self.rows = 0..0;
     }
 
+    /// Make this mask a copy of `other` (same size) without allocating: only the rows
+    /// either may have set bits in are written.
+    pub fn copy_from(&mut self, other: &Mask) {
+        assert!(
+            self.width == other.width && self.height == other.height,
+            "mask sizes differ"
+        );
+        self.clear();
+        let r = other.rows.clone();
+        let wr = r.start * self.words_per_row..r.end * self.words_per_row;
+        self.words[wr.clone()].copy_from_slice(&other.words[wr]);
+        self.rows = r;
+    }
+
     /// Set every pixel (padding bits stay zero).
     pub fn fill_all(&mut self) {
         if self.width == 0 || self.height == 0 {
