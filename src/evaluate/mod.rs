@@ -719,38 +719,4 @@ impl Problem {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn scene(name: &str) -> Problem {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("scenes")
-            .join(name);
-        Problem::new(crate::scene::load(&dir).expect("example scene loads"))
-    }
-
-    #[test]
-    fn shadows_in_image_tells_a_shadow_cut_by_the_image_edge() {
-        for name in ["mickey", "thinker"] {
-            let p = scene(name);
-            let mut ws = p.workspace();
-            p.evaluate(&p.scene.start_parameters(), &Weights::all_ones(), &mut ws);
-            let n = p.scene.occluders.len();
-            // Every body 1 m above the image centre: all inside.
-            for pose in ws.poses.iter_mut() {
-                *pose = (DVec3::new(0.0, 0.0, 1.0), DQuat::IDENTITY);
-            }
-            assert_eq!(p.shadows_in_image(&ws), vec![true; n], "{name}");
-            // The first body moved so that its shadow straddles the right edge.
-            let cam = &p.scene.camera;
-            let edge = cam.pixel_to_world(cam.width_px as f64, 0.5 * cam.height_px as f64);
-            ws.poses[0].0 = edge * (1.0 - 1.0 / cam.light_height()) + DVec3::new(0.0, 0.0, 1.0);
-            let inside = p.shadows_in_image(&ws);
-            assert!(!inside[0], "{name}: a shadow across the edge is not inside");
-            assert!(inside[1..].iter().all(|&b| b), "{name}");
-            // Behind the light plane: outside.
-            ws.poses[0].0 = DVec3::new(0.0, 0.0, cam.light_height() + 1.0);
-            assert!(!p.shadows_in_image(&ws)[0], "{name}");
-        }
-    }
-}
+mod tests;
