@@ -9,6 +9,10 @@
 //!   pieces (10,946 triangles) in flight, every pair and the table checked for contact,
 //!   the exact shadow of every mesh, all ten terms; at the scene's start guess, every
 //!   piece launched (target <= 1 ms).
+//! - `sample_thinker_one_varying`: one sample of a sequential stage of THE THINKER (the
+//!   first, `rook_a1`, its weights): the other 15 pieces held fixed
+//!   (`Problem::hold`), so the sample flies, checks and draws one piece
+//!   (`Problem::evaluate_held`; target <= 0.08 ms).
 //! - `solve_mickey_2_threads`: the whole two-stage Mickey solve on 2 threads (target <= 5 s).
 //!
 //! The wall times of the fly, tbc and thinker solves (targets 10 s, 27 s, 4 min) are
@@ -64,6 +68,18 @@ fn benches(c: &mut Criterion) {
     let mut tws = thinker.workspace();
     c.bench_function("sample_thinker_start_all_terms", |b| {
         b.iter(|| black_box(thinker.evaluate(black_box(&start), &all, &mut tws)))
+    });
+    let stage = &thinker.scene.stages[0];
+    let held = thinker.hold(&start, &stage.vary);
+    let mut sample = start.clone();
+    // A candidate near the start, as CMA-ES draws them.
+    for x in &mut sample[6 * stage.vary[0]..6 * stage.vary[0] + 6] {
+        *x += 0.02;
+    }
+    c.bench_function("sample_thinker_one_varying", |b| {
+        b.iter(|| {
+            black_box(thinker.evaluate_held(&held, black_box(&sample), &stage.weights, &mut tws))
+        })
     });
 
     let mut group = c.benchmark_group("solve");
