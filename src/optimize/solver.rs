@@ -220,21 +220,18 @@ pub fn solve(
             lambda
         ];
         let mut fitness = vec![0.0; lambda];
-        let mut best_params = params.clone();
-        let mut best_eval = problem.evaluate(&params, &stage.weights, &mut problem.workspace());
+        // What the stage holds fixed, computed once: a sample only pays for what varies.
+        let held = problem.hold(&params, &stage.vary);
         // The stage's own record of its best: the stage starts from the previous best,
         // which it must never end worse than.
+        let mut best_params = params.clone();
         let mut ws = problem.workspace();
-        let mut best_mask = {
-            problem.evaluate(&best_params, &stage.weights, &mut ws);
-            ws.mask.clone()
-        };
+        let mut best_eval = problem.evaluate_held(&held, &params, &stage.weights, &mut ws);
+        let mut best_mask = ws.mask.clone();
         let mut iteration = 0;
         let mut interrupted = false;
         let mut scratch = vec![0.0; params.len()];
         let mut candidates = vec![0.0; lambda * n];
-        // What the stage holds fixed, computed once: a sample only pays for what varies.
-        let held = problem.hold(&params, &stage.vary);
         let stop = loop {
             if interrupts.load(Ordering::SeqCst) > interrupts_at_start {
                 interrupted = true;
@@ -264,8 +261,8 @@ pub fn solve(
                     &mut scratch,
                 );
                 best_params.copy_from_slice(&scratch);
-                problem.evaluate(&best_params, &stage.weights, &mut ws);
-                best_mask.clone_from(&ws.mask);
+                problem.evaluate_held(&held, &best_params, &stage.weights, &mut ws);
+                best_mask.copy_from(&ws.mask);
             }
             cma.tell(&fitness);
             iteration += 1;
