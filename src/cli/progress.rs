@@ -3,7 +3,8 @@
 //! budget's long phases. Both draw nothing when `--quiet` is given.
 
 use std::path::PathBuf;
-use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -12,6 +13,7 @@ use crate::optimize::solver::{IterationInfo, Observer};
 use crate::output::files;
 use crate::output::solution::{SampleRecord, Solution};
 use crate::scene::{Scene, Stage};
+use crate::shadow::mask::Mask;
 
 /// A bar that draws nothing when `quiet`, so that callers update it the same way either
 /// way.
@@ -29,48 +31,56 @@ fn bar(total: u64, template: &'static str, quiet: bool) -> ProgressBar {
 }
 
 /// The observer of `bsa solve`: draws a bar per stage, prints a line per finished stage,
-/// refreshes `preview.png` and rewrites `solution.json` and `convergence.csv` after every
-/// stage, so that an interrupted solve can be resumed. Errors while writing are kept in
-/// [`SolveProgress::error`] because the solver's callbacks cannot fail.
+/// refreshes `preview.png`, and after every stage appends its rows to `convergence.csv`
+/// and rewrites `solution.json`, so that an interrupted solve can be resumed. The files
+/// are written by a [`Writer`] thread, off the optimizer's path; [`SolveProgress::finish`]
+/// waits for it and returns the first error.
 pub(super) struct SolveProgress {
-    out: PathBuf,
-    target: crate::shadow::mask::Mask,
-    /// The stage names, for the convergence table.
+    writer: Writer,
+    /// The stage names, for the convergence plot.
     pub(super) stage_names: Vec<String>,
-    /// `convergence.csv` so far (a resumed solve's skipped stages included).
-    pub(super) csv: files::ConvergenceCsv,
-    /// How many of this run's records `csv` holds.
-    pub(super) encoded: usize,
+    /// How many of this run's records were handed to the writer.
+    encoded: usize,
     bar: Option<ProgressBar>,
     quiet: bool,
     last_preview: Instant,
     stages_total: usize,
-    /// The first error while saving progress.
-    pub(super) error: Option<anyhow::Error>,
 }
 
 impl SolveProgress {
+    /// Starts `convergence.csv` in `out` with `prior` (the rows of the stages a resumed
+    /// solve skips) and the writer thread.
     pub(super) fn new(
         out: PathBuf,
         scene: &Scene,
         prior: &[SampleRecord],
         quiet: bool,
     ) -> anyhow::Result<SolveProgress> {
-        let mut csv = files::ConvergenceCsv::new(&out);
-        csv.extend(prior)?;
+        let csv = files::ConvergenceCsv::create(&out, prior)?;
         Ok(SolveProgress {
-            out,
-            target: scene.target.clone(),
+            writer: Writer::start(out, scene.target.clone(), csv),
             stage_names: scene.stages.iter().map(|s| s.name.clone()).collect(),
-            csv,
             encoded: 0,
             bar: None,
             quiet,
             // In the past, so that the first iteration already writes a preview.
             last_preview: Instant::now() - Duration::from_secs(1),
             stages_total: scene.stages.len(),
-            error: None,
         })
+    }
+
+    /// Hands over the rows of `records` (every record of the run) not saved yet, waits
+    /// until every file is written, and returns the first error while saving (with the
+    /// time spent waiting).
+    pub(super) fn finish(&mut self, records: &[SampleRecord]) -> anyhow::Result<Duration> {
+        if self.encoded < records.len() {
+            self.writer
+                .send(Job::Rows(records[self.encoded..].to_vec()));
+            self.encoded = records.len();
+        }
+        let start = Instant::now();
+        self.writer.finish()?;
+        Ok(start.elapsed())
     }
 }
 
@@ -98,18 +108,16 @@ impl Observer for SolveProgress {
                 info.samples_per_second, info.best_energy, info.best_iou
             ));
         }
-        // The preview is refreshed at most ten times a second: encoding a PNG every
-        // iteration would cost more than the optimisation itself on small scenes.
-        if self.last_preview.elapsed().as_secs_f64() >= 0.1 {
+        // The preview is refreshed at most ten times a second, and only once the writer
+        // has saved the last one: encoding a PNG every iteration would cost more than
+        // the optimisation itself on small scenes.
+        if self.last_preview.elapsed().as_secs_f64() >= 0.1 && !self.writer.preview_pending() {
             self.last_preview = Instant::now();
-            if let Err(e) = files::write_preview(&self.out, &self.target, info.best_shadow) {
-                self.error.get_or_insert(e.into());
-            }
+            self.writer.send(Job::Preview(info.best_shadow.clone()));
         }
     }
 
     fn stage_finished(&mut self, s: &Solution, records: &[SampleRecord]) {
-        // `records` is every record of this run so far: only the new ones are encoded.
         if let Some(bar) = self.bar.take() {
             bar.finish_and_clear();
         }
@@ -119,12 +127,98 @@ impl Observer for SolveProgress {
                 s.stages_completed, s.stages_total, r.name, r.iterations, r.samples, r.best_energy, r.iou, r.wall_time_s, r.stop
             );
         }
-        let res = files::write_solution(&self.out, s)
-            .and_then(|_| self.csv.extend(&records[self.encoded..]))
-            .and_then(|_| self.csv.write());
+        // `records` is every record of this run so far: only the new ones are handed over.
+        self.writer.send(Job::Stage {
+            rows: records[self.encoded..].to_vec(),
+            solution: Box::new(s.clone()),
+        });
         self.encoded = records.len();
-        if let Err(e) = res {
-            self.error.get_or_insert(e.into());
+    }
+}
+
+/// What the writer thread saves.
+enum Job {
+    /// A finished stage: its rows, then the solution so far. The rows go first: a stage
+    /// counts as completed (in `solution.json`) only once its rows are on disk, so that
+    /// a resumed solve finds them.
+    Stage {
+        rows: Vec<SampleRecord>,
+        solution: Box<Solution>,
+    },
+    /// Rows that no stage has saved.
+    Rows(Vec<SampleRecord>),
+    /// The overlay of the best shadow so far (`preview.png`).
+    Preview(Mask),
+}
+
+/// A thread that writes a solve's files in the order they are sent, so that encoding
+/// and syncing them never holds up the optimizer. After an error it writes nothing more
+/// (a later checkpoint must not pass over a missing one) and keeps the first error.
+struct Writer {
+    jobs: Option<mpsc::Sender<Job>>,
+    thread: Option<std::thread::JoinHandle<anyhow::Result<()>>>,
+    preview_pending: Arc<AtomicBool>,
+}
+
+impl Writer {
+    fn start(out: PathBuf, target: Mask, csv: files::ConvergenceCsv) -> Writer {
+        let (jobs, queue) = mpsc::channel::<Job>();
+        let preview_pending = Arc::new(AtomicBool::new(false));
+        let pending = Arc::clone(&preview_pending);
+        let thread = std::thread::spawn(move || {
+            let mut first_error = None;
+            for job in queue {
+                let result = match (&first_error, job) {
+                    (Some(_), Job::Preview(_)) => {
+                        pending.store(false, Ordering::SeqCst);
+                        continue;
+                    }
+                    (Some(_), _) => continue,
+                    (None, Job::Stage { rows, solution }) => csv
+                        .append(&rows)
+                        .and_then(|_| files::write_solution(&out, &solution)),
+                    (None, Job::Rows(rows)) => csv.append(&rows),
+                    (None, Job::Preview(mask)) => {
+                        let r = files::write_preview(&out, &target, &mask);
+                        pending.store(false, Ordering::SeqCst);
+                        r
+                    }
+                };
+                if let Err(e) = result {
+                    first_error = Some(e);
+                }
+            }
+            first_error.map_or(Ok(()), |e| Err(e.into()))
+        });
+        Writer {
+            jobs: Some(jobs),
+            thread: Some(thread),
+            preview_pending,
+        }
+    }
+
+    fn preview_pending(&self) -> bool {
+        self.preview_pending.load(Ordering::SeqCst)
+    }
+
+    fn send(&self, job: Job) {
+        if matches!(job, Job::Preview(_)) {
+            self.preview_pending.store(true, Ordering::SeqCst);
+        }
+        if let Some(jobs) = &self.jobs {
+            // The thread only stops once the sender is dropped, so sending cannot fail
+            // before `finish`; a panic in it is reported by `finish`.
+            let _ = jobs.send(job);
+        }
+    }
+
+    /// Closes the queue and waits for the thread.
+    fn finish(&mut self) -> anyhow::Result<()> {
+        self.jobs = None;
+        match self.thread.take().map(|t| t.join()) {
+            Some(Ok(result)) => result,
+            Some(Err(_)) => anyhow::bail!("the thread writing the solve's files panicked"),
+            None => Ok(()),
         }
     }
 }

@@ -58,6 +58,7 @@ impl Options {
 
 /// Solve the scene, saving progress as it goes, then write the pictures and exports.
 pub(super) fn run(opts: &Options) -> Result<()> {
+    let mut clock = Clock::new();
     let scene = load::scene(&opts.scene)?;
     let out = opts
         .out
@@ -65,6 +66,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         .unwrap_or_else(|| PathBuf::from("export").join(&scene.name));
     let problem = Problem::new(scene);
     let scene = &problem.scene;
+    clock.lap("scene loading and set-up");
     let mut prior = Vec::new();
     let resume_from = if opts.resume {
         let file = out.join("solution.json");
@@ -110,28 +112,43 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         seed,
         resume: resume_from,
     };
+    clock.lap("resume and output folder");
+    let first_stage = options.resume.as_ref().map_or(0, |s| s.stages_completed);
     let (solution, records) = solver::solve(&problem, &options, &mut observer, &INTERRUPTS);
-    if let Some(e) = observer.error.take() {
-        return Err(e.context("while saving progress"));
-    }
-    files::write_solution(&out, &solution)?;
+    // The solver's time, split: its stages, and the rest (the summary and the per-phase
+    // profile of one sample); then the wait for the files the stages left to write.
+    let solving = clock.since_lap();
+    let waiting = observer
+        .finish(&records)
+        .context("while saving progress")?
+        .as_secs_f64();
+    let stages: f64 = solution.stages[first_stage.min(solution.stages.len())..]
+        .iter()
+        .map(|r| r.wall_time_s)
+        .sum();
+    clock.record("stages (optimisation)", stages);
+    clock.record("summary and per-phase profile", solving - stages);
+    clock.record("waiting for the files of the stages", waiting);
+    clock.restart_lap();
     // The table was saved after every stage; the plot is drawn once, at the end.
-    observer.csv.extend(&records[observer.encoded..])?;
-    observer.csv.write()?;
+    files::write_solution(&out, &solution)?;
     let mut all = prior;
     all.extend(records);
     files::write_convergence_plot(&out, &observer.stage_names, &all)?;
+    clock.lap("solution, convergence table and plot");
     let mut ws = problem.workspace();
     let params = solution.parameters();
     problem.evaluate(&params, &Weights::all_ones(), &mut ws);
     files::write_pictures(&out, &scene.target, &ws.mask)?;
     files::write_preview(&out, &scene.target, &ws.mask)?;
+    clock.lap("shadow, overlay and preview");
     let exported = export::write_exports(
         &out,
         &problem,
         &solution,
         crate::output::trajectory::DEFAULT_AFTER,
     )?;
+    clock.lap("exports (motion after t, glb, CSV)");
     println!(
         "{}: IoU at t {:.4}, {} before t ({} contacts), {} samples in {} iterations, {:.2} s on {} threads{}",
         scene.name,
@@ -150,13 +167,51 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     );
     println!("{exported}");
     if opts.report {
-        print_report(&solution);
+        print_report(&solution, &clock);
     }
     Ok(())
 }
 
+/// Where the wall time of `bsa solve` went, phase by phase in the order they run.
+struct Clock {
+    start: std::time::Instant,
+    lap: std::time::Instant,
+    phases: Vec<(&'static str, f64)>,
+}
+
+impl Clock {
+    fn new() -> Clock {
+        let now = std::time::Instant::now();
+        Clock {
+            start: now,
+            lap: now,
+            phases: Vec::new(),
+        }
+    }
+
+    /// Seconds since the last lap.
+    fn since_lap(&self) -> f64 {
+        self.lap.elapsed().as_secs_f64()
+    }
+
+    /// Close the current phase under `name`.
+    fn lap(&mut self, name: &'static str) {
+        let s = self.since_lap();
+        self.record(name, s);
+        self.restart_lap();
+    }
+
+    fn record(&mut self, name: &'static str, seconds: f64) {
+        self.phases.push((name, seconds));
+    }
+
+    fn restart_lap(&mut self) {
+        self.lap = std::time::Instant::now();
+    }
+}
+
 /// The performance report of `--report`.
-fn print_report(s: &Solution) {
+fn print_report(s: &Solution, clock: &Clock) {
     println!("\nPerformance (as the paper's Tables 3 and 4)");
     let n = s.stages.len().max(1) as f64;
     println!("  stages               {}", s.stages.len());
@@ -169,7 +224,24 @@ fn print_report(s: &Solution) {
         s.wall_time_s, s.threads
     );
     println!("  time per sample phase (one core, microseconds):");
-    for (k, v) in &s.time_per_term_us {
+    // In the order a sample runs them (solution.json keeps them sorted by name).
+    let mut phases: Vec<_> = s.time_per_term_us.iter().collect();
+    phases.sort_by_key(|(k, _)| {
+        crate::evaluate::PROFILE_PHASES
+            .iter()
+            .position(|p| p == k)
+            .unwrap_or(usize::MAX)
+    });
+    for (k, v) in phases {
         println!("    {k:<26} {v:>10.2}");
     }
+    println!("  wall time of this command by phase (s):");
+    for (name, secs) in &clock.phases {
+        println!("    {name:<36} {secs:>7.3}");
+    }
+    println!(
+        "    {:<36} {:>7.3}",
+        "total (to this report)",
+        clock.start.elapsed().as_secs_f64()
+    );
 }

@@ -36,6 +36,21 @@ use crate::sim::flight::{FlightConfig, FreeFlight, LaunchState};
 /// (over 300 turns) is treated as a diverged sample.
 pub const MAX_TURN: f64 = 2000.0;
 
+/// The phases [`Problem::profile`] times, in the order a sample runs them.
+pub const PROFILE_PHASES: [&str; 11] = [
+    "flight",
+    "contacts",
+    "shadow",
+    "d0",
+    "d1",
+    "d2",
+    "xor",
+    "inner",
+    "outer",
+    "contact+reg+hint+barrier",
+    "sample (all terms)",
+];
+
 /// Contacts closer together in time than this (s) are counted as one event's contacts.
 const SIMULTANEOUS: f64 = 1e-6;
 
@@ -681,14 +696,14 @@ impl Problem {
             start.elapsed().as_secs_f64() * 1e6 / reps as f64
         };
         let us = time(&mut || self.launch(None, params, ws));
-        out.push(("flight".into(), us));
+        out.push((PROFILE_PHASES[0].into(), us));
         let us = time(&mut || {
             std::hint::black_box(self.first_contact(None, ws));
         });
-        out.push(("contacts".into(), us));
+        out.push((PROFILE_PHASES[1].into(), us));
         self.fly(params, ws);
         let us = time(&mut || self.shadow(ws));
-        out.push(("shadow".into(), us));
+        out.push((PROFILE_PHASES[2].into(), us));
         let m = ws.mask.clone();
         for term in [
             Term::D0,
@@ -704,16 +719,17 @@ impl Problem {
             let us = time(&mut || {
                 energy::image_terms(&self.target, std::hint::black_box(&m), &w, &mut raw)
             });
+            debug_assert!(PROFILE_PHASES[3..9].contains(&term.key()));
             out.push((term.key().into(), us));
         }
         let outcome = self.fly(params, ws);
         let mut raw = [0.0; TERM_COUNT];
         let us = time(&mut || self.physics_and_scene_terms(params, &outcome, ws, &mut raw));
-        out.push(("contact+reg+hint+barrier".into(), us));
+        out.push((PROFILE_PHASES[9].into(), us));
         let us = time(&mut || {
             std::hint::black_box(self.evaluate(params, &all, ws));
         });
-        out.push(("sample (all terms)".into(), us));
+        out.push((PROFILE_PHASES[10].into(), us));
         out
     }
 }

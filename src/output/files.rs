@@ -2,9 +2,10 @@
 //! `convergence.csv` and `convergence.png` in an output folder.
 //!
 //! Main functions: [`write_solution`], [`read_solution`], [`write_pictures`],
-//! [`write_convergence`], [`read_convergence`]. Every file is written atomically
-//! (a temporary file in the same folder, then a rename), so an interrupted run never
-//! leaves a half-written file behind.
+//! [`ConvergenceCsv`], [`write_convergence_plot`], [`read_convergence`]. Every file is
+//! written atomically (a temporary file in the same folder, then a rename), so an
+//! interrupted run never leaves a half-written file behind; the one exception,
+//! `convergence.csv`, grows by synced appends of whole stages (see [`ConvergenceCsv`]).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -130,73 +131,75 @@ pub fn write_preview(dir: &Path, target: &Mask, shadow: &Mask) -> Result<()> {
     save_png(&overlay(target, shadow), &dir.join("preview.png"))
 }
 
-/// `convergence.csv` (every sample: stage, iteration, each weighted term, total) and
-/// `convergence.png` (one log-scale panel per stage).
-pub fn write_convergence(
-    dir: &Path,
-    stage_names: &[String],
-    records: &[SampleRecord],
-) -> Result<()> {
-    let mut csv = ConvergenceCsv::new(dir);
-    csv.extend(records)?;
-    csv.write()?;
-    write_convergence_plot(dir, stage_names, records)
-}
-
-/// `convergence.csv` kept as its encoded text, so that a solve that saves after every
-/// stage encodes each row once (and not the whole table again at every stage).
+/// `convergence.csv` (every sample: stage, iteration, each weighted term, total), grown
+/// stage by stage while a solve runs: [`ConvergenceCsv::create`] writes the header and
+/// the rows kept from earlier stages atomically, then [`ConvergenceCsv::append`] adds each
+/// stage's rows and syncs them, so a stage costs only its own rows (not the whole table
+/// again). A solve appends a stage's rows before it records the stage as completed in
+/// `solution.json`, so after an interruption the table holds every completed stage, and
+/// at most a cut-off last row that [`read_convergence`] ignores.
 pub struct ConvergenceCsv {
     path: PathBuf,
-    bytes: Vec<u8>,
 }
 
 impl ConvergenceCsv {
-    /// The table with its header and no row yet, to be written in `dir`.
-    pub fn new(dir: &Path) -> ConvergenceCsv {
+    /// Start `dir/convergence.csv` with its header and `records`.
+    pub fn create(dir: &Path, records: &[SampleRecord]) -> Result<ConvergenceCsv> {
+        let path = dir.join("convergence.csv");
         let mut header = vec!["stage".to_string(), "iteration".to_string()];
         header.extend(Term::ALL.iter().map(|t| t.key().to_string()));
         header.push("total".into());
-        let mut csv = ConvergenceCsv {
-            path: dir.join("convergence.csv"),
-            bytes: Vec::new(),
-        };
-        csv.encode(|w| w.write_record(&header))
-            .expect("encoding into memory cannot fail");
-        csv
+        let mut bytes = encode_rows(&path, |w| w.write_record(&header))?;
+        bytes.extend(encode_records(&path, records)?);
+        write_atomic(&path, &bytes)?;
+        Ok(ConvergenceCsv { path })
     }
 
-    /// Append rows.
-    pub fn extend(&mut self, records: &[SampleRecord]) -> Result<()> {
-        self.encode(|w| {
-            for r in records {
-                let mut row = vec![r.stage.to_string(), r.iteration.to_string()];
-                row.extend(r.terms.iter().map(|x| format!("{x:e}")));
-                row.push(format!("{:e}", r.total));
-                w.write_record(&row)?;
-            }
-            Ok(())
-        })
-    }
-
-    fn encode(
-        &mut self,
-        f: impl FnOnce(&mut csv::Writer<&mut Vec<u8>>) -> csv::Result<()>,
-    ) -> Result<()> {
-        let enc = |message: String| ExportError::Encode {
+    /// Append rows, synced to disk before returning.
+    pub fn append(&self, records: &[SampleRecord]) -> Result<()> {
+        let bytes = encode_records(&self.path, records)?;
+        let err = |source| ExportError::Write {
             path: self.path.clone(),
-            message,
+            source,
         };
-        let mut w = csv::WriterBuilder::new()
-            .has_headers(false)
-            .from_writer(&mut self.bytes);
-        f(&mut w).map_err(|e| enc(e.to_string()))?;
-        w.flush().map_err(|e| enc(e.to_string()))
+        let mut f = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&self.path)
+            .map_err(err)?;
+        f.write_all(&bytes).map_err(err)?;
+        f.sync_data().map_err(err)
     }
+}
 
-    /// Write the table so far, atomically.
-    pub fn write(&self) -> Result<()> {
-        write_atomic(&self.path, &self.bytes)
-    }
+fn encode_records(path: &Path, records: &[SampleRecord]) -> Result<Vec<u8>> {
+    encode_rows(path, |w| {
+        for r in records {
+            let mut row = vec![r.stage.to_string(), r.iteration.to_string()];
+            row.extend(r.terms.iter().map(|x| format!("{x:e}")));
+            row.push(format!("{:e}", r.total));
+            w.write_record(&row)?;
+        }
+        Ok(())
+    })
+}
+
+/// CSV text of the rows that `f` writes (no header line of its own).
+fn encode_rows(
+    path: &Path,
+    f: impl FnOnce(&mut csv::Writer<&mut Vec<u8>>) -> csv::Result<()>,
+) -> Result<Vec<u8>> {
+    let enc = |message: String| ExportError::Encode {
+        path: path.to_path_buf(),
+        message,
+    };
+    let mut bytes = Vec::new();
+    let mut w = csv::WriterBuilder::new()
+        .has_headers(false)
+        .from_writer(&mut bytes);
+    f(&mut w).map_err(|e| enc(e.to_string()))?;
+    w.flush().map_err(|e| enc(e.to_string()))?;
+    drop(w);
+    Ok(bytes)
 }
 
 /// `convergence.png`: one log-scale panel per stage.
@@ -244,15 +247,29 @@ pub fn read_convergence(path: &Path, stages: usize) -> Result<Vec<SampleRecord>>
     };
     let mut r = csv::Reader::from_path(path).map_err(|e| bad(e.to_string()))?;
     let mut out = Vec::new();
+    // A malformed row is an error unless it is the last one: a solve stopped in the
+    // middle of appending a stage leaves a cut-off last row of a stage that was not
+    // completed (see `ConvergenceCsv`).
+    let mut damaged = None;
     for row in r.records() {
-        let row = row.map_err(|e| bad(e.to_string()))?;
-        if row.len() != TERM_COUNT + 3 {
-            return Err(bad(format!(
-                "a row has {} columns, expected {}",
-                row.len(),
-                TERM_COUNT + 3
-            )));
+        if let Some(e) = damaged.take() {
+            return Err(e);
         }
+        let row = match row {
+            Ok(row) if row.len() == TERM_COUNT + 3 => row,
+            Ok(row) => {
+                damaged = Some(bad(format!(
+                    "a row has {} columns, expected {}",
+                    row.len(),
+                    TERM_COUNT + 3
+                )));
+                continue;
+            }
+            Err(e) => {
+                damaged = Some(bad(e.to_string()));
+                continue;
+            }
+        };
         let num = |i: usize| -> Result<f64> {
             row[i]
                 .parse::<f64>()
@@ -274,4 +291,67 @@ pub fn read_convergence(path: &Path, stages: usize) -> Result<Vec<SampleRecord>>
         });
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn records(stages: usize, per_stage: usize) -> Vec<SampleRecord> {
+        (0..stages * per_stage)
+            .map(|k| SampleRecord {
+                stage: k / per_stage,
+                iteration: k % per_stage,
+                terms: std::array::from_fn(|t| (k * 10 + t) as f64 * 0.125),
+                total: k as f64 + 0.5,
+            })
+            .collect()
+    }
+
+    fn dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("bsa-files-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    #[test]
+    fn convergence_grown_by_appends_reads_back_whole() {
+        let d = dir("appends");
+        let all = records(3, 4);
+        let csv = ConvergenceCsv::create(&d, &all[..4]).unwrap();
+        csv.append(&all[4..8]).unwrap();
+        csv.append(&all[8..]).unwrap();
+        let path = d.join("convergence.csv");
+        assert_eq!(read_convergence(&path, 3).unwrap(), all);
+        // Only the completed stages are kept on resume.
+        assert_eq!(read_convergence(&path, 2).unwrap(), &all[..8]);
+        // The same bytes as a table written in one go.
+        let d2 = dir("one-go");
+        ConvergenceCsv::create(&d2, &all).unwrap();
+        assert_eq!(
+            std::fs::read(&path).unwrap(),
+            std::fs::read(d2.join("convergence.csv")).unwrap()
+        );
+    }
+
+    #[test]
+    fn a_cut_off_last_row_is_ignored_and_a_damaged_middle_row_is_not() {
+        let d = dir("cut");
+        let all = records(2, 3);
+        ConvergenceCsv::create(&d, &all).unwrap();
+        let path = d.join("convergence.csv");
+        let text = std::fs::read_to_string(&path).unwrap();
+        // Cut inside the last row's first field: one column left.
+        let cut = text
+            .rfind('\n')
+            .map_or(0, |_| text.trim_end().rfind('\n').unwrap() + 2);
+        std::fs::write(&path, &text[..cut]).unwrap();
+        assert_eq!(read_convergence(&path, 1).unwrap(), &all[..3]);
+        // The same damage in the middle of the table is an error.
+        let lines: Vec<&str> = text.lines().collect();
+        let mut damaged = lines.clone();
+        damaged[2] = "0";
+        std::fs::write(&path, damaged.join("\n") + "\n").unwrap();
+        assert!(read_convergence(&path, 2).is_err());
+    }
 }
