@@ -121,6 +121,15 @@ impl Pool {
     }
 }
 
+/// Repetitions of the per-phase profile in `solution.json`: as many as fit in about
+/// 20 ms (a profile repetition costs about two samples), from 5 to 200.
+fn profile_reps(problem: &Problem, params: &[f64], ws: &mut Workspace) -> usize {
+    let start = Instant::now();
+    problem.evaluate(params, &Weights::all_ones(), ws);
+    let sample = start.elapsed().as_secs_f64().max(1e-9);
+    ((0.02 / (2.0 * sample)) as usize).clamp(5, 200)
+}
+
 /// Seed of stage `k`'s CMA-ES: a SplitMix64 step, so that every stage of every seed has
 /// its own stream and a resumed solve draws exactly what an uninterrupted one would.
 fn stage_seed(seed: u64, k: usize) -> u64 {
@@ -323,7 +332,7 @@ pub fn solve(
         && completed == scene.stages.len()
         && reports.iter().all(|r| !r.stop.starts_with("interrupted"));
     let mut ws = problem.workspace();
-    let timing = problem.profile(&params, 200, &mut ws);
+    let timing = problem.profile(&params, profile_reps(problem, &params, &mut ws), &mut ws);
     let run = Run {
         seed,
         stages_completed: completed,
