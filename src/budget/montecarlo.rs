@@ -33,10 +33,25 @@ pub struct Budget<'a> {
     pub vacuum_iou: f64,
 }
 
+/// Drag flights flown together in one batch (a multiple of four, the width of
+/// [`drag::fly_each`]).
+const MAX_BATCH: usize = 16;
+
 /// Per-thread buffers of the budget.
 pub struct BudgetWorkspace {
     pub(super) ws: Workspace,
     flight: FreeFlight,
+    /// Per body, the last centre of mass with drag and the last orientation at `t`,
+    /// with the bits of the inputs they were computed from. In a search over one error
+    /// alone most bodies' other half does not change from sample to sample (a speed
+    /// error leaves the spin, a spin error the drag flight), and a match gives the same
+    /// bits as computing again.
+    last_com: Vec<Option<([u64; 8], DVec3)>>,
+    last_q: Vec<Option<([u64; 4], DQuat)>>,
+    /// The drag flights a sample still has to fly, their bodies and results.
+    flights: Vec<drag::Flight>,
+    flown: Vec<usize>,
+    flown_to: Vec<(DVec3, DVec3)>,
 }
 
 /// Rotate `v` by the direction error `d` (rad) about two axes perpendicular to it: the
@@ -186,9 +201,15 @@ impl<'a> Budget<'a> {
     }
 
     pub fn workspace(&self) -> BudgetWorkspace {
+        let n = self.problem.scene.occluders.len();
         BudgetWorkspace {
             ws: self.problem.workspace(),
             flight: FreeFlight::default(),
+            last_com: vec![None; n],
+            last_q: vec![None; n],
+            flights: Vec::with_capacity(n),
+            flown: Vec::with_capacity(n),
+            flown_to: Vec::with_capacity(n),
         }
     }
 
@@ -202,48 +223,90 @@ impl<'a> Budget<'a> {
         e: &BodyError,
         flight: Option<&mut FreeFlight>,
     ) -> (DVec3, DQuat) {
+        let Some((v, w, tau)) = self.perturbed(v, w, e) else {
+            return (DVec3::NAN, DQuat::NAN);
+        };
+        let com = self.drag_com_of(i, v, w, e.cd, tau);
+        let q = flight.map_or(DQuat::IDENTITY, |f| self.orientation_of(i, w, tau, f));
+        (com, q)
+    }
+
+    /// The launch velocity, spin and flight time of a launch `v`, `w` with errors `e`;
+    /// `None` for a launch no flight can follow.
+    fn perturbed(&self, v: DVec3, w: DVec3, e: &BodyError) -> Option<(DVec3, DVec3, f64)> {
         let scene = &self.problem.scene;
-        let o = &scene.occluders[i];
         let v = aim(v, e.direction) * (1.0 + e.speed);
         let w = w * (1.0 + e.spin);
         let tau = scene.t - e.timing;
-        if !(v.is_finite() && w.is_finite()) || w.length() * scene.t > MAX_TURN {
-            return (DVec3::NAN, DQuat::NAN);
-        }
-        let body = if e.cd != 0.0 {
-            self.bodies[i].with_cd_factor(1.0 + e.cd)
+        (v.is_finite() && w.is_finite() && w.length() * scene.t <= MAX_TURN).then_some((v, w, tau))
+    }
+
+    /// Occluder `i`'s drag model with its drag coefficient off by the factor
+    /// `1 + cd_error`.
+    fn body_with_cd(&self, i: usize, cd_error: f64) -> BodyDrag {
+        if cd_error != 0.0 {
+            self.bodies[i].with_cd_factor(1.0 + cd_error)
         } else {
             self.bodies[i]
-        };
-        let (com, _) = drag::fly(
+        }
+    }
+
+    /// Fly the drag flights queued in `bws` together and keep their centres of mass in
+    /// its memo under `keys`.
+    fn fly_batch(&self, bws: &mut BudgetWorkspace, keys: &[[u64; 8]; MAX_BATCH]) {
+        bws.flown_to.clear();
+        bws.flown_to
+            .resize(bws.flights.len(), (DVec3::ZERO, DVec3::ZERO));
+        let scene = &self.problem.scene;
+        drag::fly_each(
+            &bws.flights,
+            scene.gravity,
+            self.drag.max_step,
+            &mut bws.flown_to,
+        );
+        for (k, &i) in bws.flown.iter().enumerate() {
+            bws.last_com[i] = Some((keys[k], bws.flown_to[k].0));
+        }
+        bws.flights.clear();
+        bws.flown.clear();
+    }
+
+    /// Centre of mass with drag of occluder `i` after `tau` from launch `v`, `w`, its
+    /// drag coefficient off by the factor `1 + cd_error`.
+    fn drag_com_of(&self, i: usize, v: DVec3, w: DVec3, cd_error: f64, tau: f64) -> DVec3 {
+        let scene = &self.problem.scene;
+        let body = self.body_with_cd(i, cd_error);
+        drag::fly(
             &body,
-            o.launch_com(),
+            scene.occluders[i].launch_com(),
             v,
             w,
             scene.gravity,
             tau,
             self.drag.max_step,
+        )
+        .0
+    }
+
+    /// Orientation of occluder `i` after `tau` from launch spin `w` (drag exerts no
+    /// torque in the model, so it is the torque-free one).
+    fn orientation_of(&self, i: usize, w: DVec3, tau: f64, f: &mut FreeFlight) -> DQuat {
+        let scene = &self.problem.scene;
+        let o = &scene.occluders[i];
+        f.reset(
+            &o.mass,
+            LaunchState::of(
+                o,
+                Launch {
+                    velocity: DVec3::ZERO,
+                    angular_velocity: w,
+                },
+            ),
+            scene.gravity,
+            tau.max(scene.t),
+            &self.problem.flight,
         );
-        let q = match flight {
-            Some(f) => {
-                f.reset(
-                    &o.mass,
-                    LaunchState::of(
-                        o,
-                        Launch {
-                            velocity: v,
-                            angular_velocity: w,
-                        },
-                    ),
-                    scene.gravity,
-                    tau.max(scene.t),
-                    &self.problem.flight,
-                );
-                f.orientation(tau)
-            }
-            None => DQuat::IDENTITY,
-        };
-        (com, q)
+        f.orientation(tau)
     }
 
     /// Drag poses at `t` of every occluder for launch `params` with errors `errors`
@@ -256,16 +319,72 @@ impl<'a> Budget<'a> {
         bws: &mut BudgetWorkspace,
     ) -> (f64, bool) {
         let scene = &self.problem.scene;
+        let bits = |x: DVec3| x.to_array().map(f64::to_bits);
+        // First the drag flights that the memo does not hold, flown together; then the
+        // orientations; then the poses.
+        bws.flights.clear();
+        bws.flown.clear();
+        let mut keys = [[0u64; 8]; MAX_BATCH];
         for (i, o) in scene.occluders.iter().enumerate() {
             if !o.launched {
-                bws.ws.poses[i] = (o.position, o.orientation);
                 continue;
             }
             let Launch {
                 velocity: v,
                 angular_velocity: w,
             } = Launch::get(params, i);
-            let (com, q) = self.pose(i, v, w, &errors[i], Some(&mut bws.flight));
+            let e = &errors[i];
+            let Some((v, w, tau)) = self.perturbed(v, w, e) else {
+                return (0.0, true);
+            };
+            // The drag flight reads the spin only through the Magnus lift.
+            let wb = if self.bodies[i].magnus_radius.is_some() {
+                bits(w)
+            } else {
+                [0; 3]
+            };
+            let vb = bits(v);
+            let key = [
+                vb[0],
+                vb[1],
+                vb[2],
+                wb[0],
+                wb[1],
+                wb[2],
+                tau.to_bits(),
+                e.cd.to_bits(),
+            ];
+            if bws.last_com[i].is_none_or(|(k, _)| k != key) {
+                if bws.flown.len() == MAX_BATCH {
+                    self.fly_batch(bws, &keys);
+                }
+                keys[bws.flown.len()] = key;
+                bws.flown.push(i);
+                bws.flights.push(drag::Flight {
+                    body: self.body_with_cd(i, e.cd),
+                    x0: o.launch_com(),
+                    v0: v,
+                    w,
+                    duration: tau,
+                });
+            }
+            let wb = bits(w);
+            let q_key = [wb[0], wb[1], wb[2], tau.to_bits()];
+            if bws.last_q[i].is_none_or(|(k, _)| k != q_key) {
+                let q = self.orientation_of(i, w, tau, &mut bws.flight);
+                bws.last_q[i] = Some((q_key, q));
+            }
+        }
+        self.fly_batch(bws, &keys);
+        for (i, o) in scene.occluders.iter().enumerate() {
+            if !o.launched {
+                bws.ws.poses[i] = (o.position, o.orientation);
+                continue;
+            }
+            let (com, q) = match (bws.last_com[i], bws.last_q[i]) {
+                (Some((_, com)), Some((_, q))) => (com, q),
+                _ => unreachable!("every launched body was flown above"),
+            };
             if !(com.is_finite() && q.is_finite()) {
                 return (0.0, true);
             }
@@ -393,10 +512,82 @@ impl<'a> Budget<'a> {
         pool: &rayon::ThreadPool,
         progress: &dyn Progress,
     ) -> (Vec<f64>, usize) {
+        let out = if tol.to_array() == [0.0; 5] {
+            // Without errors every sample is the exact compensated launch (a zero
+            // tolerance draws zero errors, and a zero error changes no bit): one will do.
+            let one = self.samples(params, tol, 0..n.min(1), seed, pool, &());
+            progress.advance(n as u64);
+            vec![one.first().copied().unwrap_or((0.0, false)); n]
+        } else {
+            let out = self.samples(params, tol, 0..n, seed, pool, progress);
+            progress.advance(n as u64 % 64);
+            out
+        };
+        let diverged = out.iter().filter(|r| r.1).count();
+        (out.into_iter().map(|r| r.0).collect(), diverged)
+    }
+
+    /// Whether `P(IoU >= threshold) >= PROBABILITY_TARGET` over the `n` samples of
+    /// [`Budget::monte_carlo`]: the same answer as counting them all, but the samples are
+    /// taken a chunk at a time and the count stops as soon as it is decided (enough
+    /// successes, or too many failures), which is most of the time in a tolerance search.
+    pub fn reaches(
+        &self,
+        params: &[f64],
+        tol: &Tolerances,
+        n: usize,
+        seed: u64,
+        threshold: f64,
+        pool: &rayon::ThreadPool,
+    ) -> bool {
+        /// Samples taken between two looks at the count.
+        const CHUNK: usize = 128;
+        // The least number of successes whose fraction reaches the target, as IouStats
+        // computes the fraction.
+        let Some(needed) = (0..=n).find(|&c| c as f64 / n.max(1) as f64 >= PROBABILITY_TARGET)
+        else {
+            return false;
+        };
+        if tol.to_array() == [0.0; 5] {
+            let (ious, _) = self.monte_carlo(params, tol, n.min(1), seed, pool, &());
+            let each = ious.first().is_some_and(|&x| x >= threshold);
+            return if each { n >= needed } else { needed == 0 };
+        }
+        let (mut yes, mut no) = (0, 0);
+        let mut start = 0;
+        loop {
+            if yes >= needed {
+                return true;
+            }
+            if no > n - needed || start >= n {
+                return false;
+            }
+            let end = (start + CHUNK).min(n);
+            for (iou, _) in self.samples(params, tol, start..end, seed, pool, &()) {
+                if iou >= threshold {
+                    yes += 1;
+                } else {
+                    no += 1;
+                }
+            }
+            start = end;
+        }
+    }
+
+    /// (IoU, diverged) of the samples `range`, in sample order.
+    fn samples(
+        &self,
+        params: &[f64],
+        tol: &Tolerances,
+        range: std::ops::Range<usize>,
+        seed: u64,
+        pool: &rayon::ThreadPool,
+        progress: &dyn Progress,
+    ) -> Vec<(f64, bool)> {
         let nb = self.problem.scene.occluders.len();
         let done = AtomicU64::new(0);
-        let out: Vec<(f64, bool)> = pool.install(|| {
-            (0..n)
+        pool.install(|| {
+            range
                 .into_par_iter()
                 .map_init(
                     || (self.workspace(), vec![BodyError::default(); nb]),
@@ -411,9 +602,6 @@ impl<'a> Budget<'a> {
                     },
                 )
                 .collect()
-        });
-        progress.advance(n as u64 % 64);
-        let diverged = out.iter().filter(|r| r.1).count();
-        (out.into_iter().map(|r| r.0).collect(), diverged)
+        })
     }
 }

@@ -139,7 +139,7 @@ pub(super) fn search(
         let (ious, diverged) = b.monte_carlo(comp, tol, m, seed, pool, &());
         IouStats::new(&ious, diverged, opts.iou_threshold)
     };
-    let ok = |s: &IouStats| s.p_iou_at_least_threshold >= PROBABILITY_TARGET;
+    let ok = |tol: &Tolerances| b.reaches(comp, tol, m, seed, opts.iou_threshold, pool);
     progress.start("tolerance search", 6);
     let mut single = Vec::new();
     for (p, (name, unit, _)) in PARAMETERS.iter().enumerate() {
@@ -149,7 +149,7 @@ pub(super) fn search(
             Tolerances::from_array(a)
         };
         let start = if user[p] > 0.0 { user[p] } else { defaults[p] };
-        let (best, at_limit) = largest(start, limits[p], &mut |s| ok(&stats(&at(s))));
+        let (best, at_limit) = largest(start, limits[p], &mut |s| ok(&at(s)));
         let top = if best > 0.0 { 2.0 * best } else { 2.0 * start }.min(limits[p]);
         let curve = (0..CURVE_POINTS)
             .map(|j| {
@@ -181,7 +181,7 @@ pub(super) fn search(
         .fold(f64::INFINITY, f64::min);
     let (joint_scale, joint_at_limit) = if max_scale.is_finite() {
         let scaled = |s: f64| Tolerances::from_array(user.map(|u| u * s));
-        largest(1.0, max_scale, &mut |s| ok(&stats(&scaled(s))))
+        largest(1.0, max_scale, &mut |s| ok(&scaled(s)))
     } else {
         (0.0, false)
     };
