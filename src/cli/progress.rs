@@ -108,10 +108,10 @@ impl Observer for SolveProgress {
                 info.samples_per_second, info.best_energy, info.best_iou
             ));
         }
-        // The preview is refreshed at most ten times a second, and only once the writer
+        // The preview is refreshed at most four times a second, and only once the writer
         // has saved the last one: encoding a PNG every iteration would cost more than
         // the optimisation itself on small scenes.
-        if self.last_preview.elapsed().as_secs_f64() >= 0.1 && !self.writer.preview_pending() {
+        if self.last_preview.elapsed().as_secs_f64() >= 0.25 && !self.writer.preview_pending() {
             self.last_preview = Instant::now();
             self.writer.send(Job::Preview(info.best_shadow.clone()));
         }

@@ -122,12 +122,12 @@ impl Pool {
 }
 
 /// Repetitions of the per-phase profile in `solution.json`: as many as fit in about
-/// 20 ms (a profile repetition costs about two samples), from 5 to 200.
+/// 10 ms (a profile repetition costs about two samples), from 5 to 100.
 fn profile_reps(problem: &Problem, params: &[f64], ws: &mut Workspace) -> usize {
     let start = Instant::now();
     problem.evaluate(params, &Weights::all_ones(), ws);
     let sample = start.elapsed().as_secs_f64().max(1e-9);
-    ((0.02 / (2.0 * sample)) as usize).clamp(5, 200)
+    ((0.01 / (2.0 * sample)) as usize).clamp(5, 100)
 }
 
 /// Seed of stage `k`'s CMA-ES: a SplitMix64 step, so that every stage of every seed has
