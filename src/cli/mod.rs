@@ -4,7 +4,8 @@
 //! write `export/<scene>/`), `eval` (print every energy term of a saved solution),
 //! `export` (animated glTF and launch tables of a saved solution), `validate` (Blender
 //! Cycles shadow against the rasterizer), `video` (an MP4 of the flight) and `budget`
-//! (air drag, the drag-compensated launch table and launch tolerances). `validate`
+//! (air drag, the drag-compensated launch table and launch tolerances), and `render`
+//! (the shadow of any launch at any instant up to `t`). `validate`
 //! and `video` run the scripts of `blender/` with a Python that has `bpy`.
 //!
 //! Each subcommand lives in its own file and runs in two steps, in the way of ripgrep:
@@ -22,6 +23,7 @@ mod eval;
 mod export;
 mod load;
 mod progress;
+mod render;
 mod solve;
 mod validate;
 mod video;
@@ -63,6 +65,9 @@ enum Command {
     Budget(BudgetArgs),
     /// Print every energy term of a solution, raw and weighted.
     Eval(EvalArgs),
+    /// Draw the shadow of any launch (solution.json, launch.csv or a launch file) at t or
+    /// another instant: shadow.png, overlay.png and the IoU.
+    Render(RenderArgs),
 }
 
 // Raw arguments of `bsa check`.
@@ -220,6 +225,24 @@ struct EvalArgs {
     profile: Option<usize>,
 }
 
+// Raw arguments of `bsa render`.
+#[derive(Args)]
+struct RenderArgs {
+    /// Scene folder (holding scene.json) or scene file.
+    scene: PathBuf,
+    /// The launch: a solution.json, a launch.csv, or a JSON file mapping each launched
+    /// occluder's name to {"velocity": [x, y, z], "angular_velocity": [x, y, z]} (m/s,
+    /// rad/s).
+    #[arg(long)]
+    solution: PathBuf,
+    /// Output folder [default: render/ beside the launch file].
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// The instant of the shadow (s, after the launch, at most t) [default: t].
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    at: Option<f64>,
+}
+
 /// Run the parsed command line: validate the subcommand's options, then run it.
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
@@ -230,5 +253,6 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Validate(args) => validate::run(&validate::Options::new(args)),
         Command::Video(args) => video::run(&video::Options::new(args)?),
         Command::Budget(args) => budget::run(&budget::Options::new(args)),
+        Command::Render(args) => render::run(&render::Options::new(args)?),
     }
 }

@@ -7,6 +7,7 @@
 pub mod cycles;
 pub mod files;
 pub mod gltf;
+pub mod launches;
 pub mod picture;
 pub mod solution;
 pub mod trajectory;

@@ -14,6 +14,7 @@
 mod blender;
 mod cli;
 mod exports;
+mod render;
 mod scene_errors;
 mod solver;
 mod util;

@@ -1,0 +1,128 @@
+//! `bsa render`: the shadow of any launch, from a solve's `solution.json`, its
+//! `launch.csv` or a minimal launch file, and clear errors for launch files that do not
+//! fit the scene.
+
+use std::path::Path;
+
+use crate::util::{bsa, quick_solve, root, tmpdir};
+
+fn render(scene: &Path, launch: &Path, out: &Path) -> (bool, String, String) {
+    bsa(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--solution",
+        launch.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ])
+}
+
+#[test]
+fn render_reproduces_the_solves_shadow_from_solution_json_and_launch_csv() {
+    for name in ["mickey", "fly"] {
+        let scene = root().join("scenes").join(name);
+        let solved = quick_solve(&scene, &format!("render-{name}"));
+        let scene_file = solved.parent().unwrap();
+        let want = std::fs::read(solved.join("shadow.png")).unwrap();
+        for launch in ["solution.json", "launch.csv"] {
+            let out = solved.join(format!("render-{launch}"));
+            let (ok, stdout, err) = render(scene_file, &solved.join(launch), &out);
+            assert!(ok && stdout.contains("IoU at"), "{name} {launch}: {err}");
+            let got = std::fs::read(out.join("shadow.png")).unwrap();
+            assert!(
+                got == want,
+                "{name}: shadow from {launch} differs from the solve's"
+            );
+            assert!(out.join("overlay.png").is_file());
+        }
+    }
+}
+
+#[test]
+fn render_takes_a_minimal_launch_file_and_another_instant() {
+    let d = tmpdir("render-minimal");
+    let launch = d.join("launch.json");
+    std::fs::write(
+        &launch,
+        r#"{"head": {"velocity": [0.0, 1.5, 6.35], "angular_velocity": [0.2, 0.5, 0.2]},
+            "left_ear": {"velocity": [1.46, -0.39, 7.06]},
+            "right_ear": {"velocity": [-1.46, -0.39, 7.06]}}"#,
+    )
+    .unwrap();
+    let scene = root().join("scenes/mickey");
+    let (ok, out, err) = render(&scene, &launch, &d.join("t"));
+    assert!(ok, "{err}");
+    // Near the seed-1 solution: the picture reads as Mickey.
+    let iou: f64 = out.split("IoU at 1.2 s ").nth(1).unwrap()[..6]
+        .parse()
+        .unwrap();
+    assert!(iou > 0.9, "{out}");
+    let (ok, out, err) = bsa(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--solution",
+        launch.to_str().unwrap(),
+        "--out",
+        d.join("early").to_str().unwrap(),
+        "--at",
+        "0.6",
+    ]);
+    assert!(ok && out.contains("IoU at 0.6 s"), "{err}");
+    let (ok, _, err) = bsa(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--solution",
+        launch.to_str().unwrap(),
+        "--at",
+        "5",
+    ]);
+    assert!(!ok && err.contains("after t"), "{err}");
+}
+
+#[test]
+fn bad_launch_files_name_the_file_and_the_entry() {
+    let d = tmpdir("render-bad");
+    let scene = root().join("scenes/mickey");
+    let cases: [(&str, &str, &[&str]); 6] = [
+        (
+            "unknown.json",
+            r#"{"head": {"velocity": [0, 1, 6]}, "left_ear": {"velocity": [1, 0, 7]},
+                "right_ear": {"velocity": [-1, 0, 7]}, "nose": {"velocity": [0, 0, 1]}}"#,
+            &["unknown.json", "`nose`", "no occluder"],
+        ),
+        (
+            "missing.json",
+            r#"{"head": {"velocity": [0, 1, 6]}}"#,
+            &["missing.json", "no launch for occluder `left_ear`"],
+        ),
+        (
+            "typo.json",
+            r#"{"head": {"velocty": [0, 1, 6]}}"#,
+            &["typo.json", "velocty"],
+        ),
+        (
+            "missing.csv",
+            "name,vx_m_s,vy_m_s,vz_m_s,wx_rad_s,wy_rad_s,wz_rad_s\nhead,0,1,6,0,0,0\n",
+            &["missing.csv", "no launch for occluder `left_ear`"],
+        ),
+        (
+            "nan.csv",
+            "name,vx_m_s,vy_m_s,vz_m_s,wx_rad_s,wy_rad_s,wz_rad_s\nhead,0,NaN,6,0,0,0\n",
+            &["nan.csv", "row 2", "`velocity` must be a finite number"],
+        ),
+        (
+            "columns.csv",
+            "name,vx,vy,vz\nhead,0,1,6\n",
+            &["columns.csv", "no column `vx_m_s`"],
+        ),
+    ];
+    for (file, text, expect) in cases {
+        let path = d.join(file);
+        std::fs::write(&path, text).unwrap();
+        let (ok, _, err) = render(&scene, &path, &d.join("out"));
+        assert!(!ok && !err.contains("panicked"), "{file}: {err}");
+        for e in expect {
+            assert!(err.contains(e), "{file}: expected `{e}` in: {err}");
+        }
+    }
+}
