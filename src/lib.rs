@@ -12,6 +12,7 @@
 
 pub mod budget;
 pub mod cli;
+pub mod design;
 pub mod energy;
 pub mod evaluate;
 pub mod geometry;

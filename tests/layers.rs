@@ -5,9 +5,9 @@
 use std::path::{Path, PathBuf};
 
 /// The library's top-level modules, lowest layer first.
-const LAYERS: [&str; 11] = [
-    "linalg", "geometry", "shadow", "energy", "scene", "sim", "evaluate", "output", "optimize",
-    "budget", "cli",
+const LAYERS: [&str; 12] = [
+    "linalg", "geometry", "shadow", "energy", "scene", "sim", "evaluate", "design", "output",
+    "optimize", "budget", "cli",
 ];
 
 fn rank(module: &str) -> Option<usize> {

@@ -22,6 +22,7 @@ mod check;
 mod eval;
 mod export;
 mod load;
+mod plant;
 mod progress;
 mod render;
 mod solve;
@@ -68,6 +69,10 @@ enum Command {
     /// Draw the shadow of any launch (solution.json, launch.csv or a launch file) at t or
     /// another instant: shadow.png, overlay.png and the IoU.
     Render(RenderArgs),
+    /// Plant a problem with a known answer: a random contact-free launch of a box of
+    /// objects whose shadow becomes the target; writes scene.json, target.png and
+    /// planted.json (the launch) into DIR.
+    Plant(PlantArgs),
 }
 
 // Raw arguments of `bsa check`.
@@ -243,6 +248,29 @@ struct RenderArgs {
     at: Option<f64>,
 }
 
+// Raw arguments of `bsa plant`.
+#[derive(Args)]
+struct PlantArgs {
+    /// Folder to write the problem into (created if needed).
+    dir: PathBuf,
+    /// The objects: comma-separated sphere:R, box:XxYxZ or mesh:FILE.obj[@SCALE], each
+    /// with an optional *N count and /DENSITY (metres, kg/m^3; default 705, maple).
+    #[arg(long)]
+    objects: String,
+    /// Seed of the draw (and of the scene's solve).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// The picture's width on the floor (m); its height is 3/4 of it.
+    #[arg(long, value_name = "M", default_value_t = 1.6)]
+    width: f64,
+    /// The point light's height above the picture (m).
+    #[arg(long, value_name = "M", default_value_t = 6.0)]
+    light_height: f64,
+    /// The instant of the picture (s after the launch).
+    #[arg(long, value_name = "S", default_value_t = 1.2)]
+    t: f64,
+}
+
 /// Run the parsed command line: validate the subcommand's options, then run it.
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
@@ -254,5 +282,6 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Video(args) => video::run(&video::Options::new(args)?),
         Command::Budget(args) => budget::run(&budget::Options::new(args)),
         Command::Render(args) => render::run(&render::Options::new(args)?),
+        Command::Plant(args) => plant::run(&plant::Options::new(args)?),
     }
 }

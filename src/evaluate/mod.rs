@@ -550,6 +550,12 @@ impl Problem {
         self.shadow_with(None, None, ws)
     }
 
+    /// The shadow of the occluders in `which` only (`which[i]`), at the poses in
+    /// `ws.poses`, into `ws.mask`.
+    pub fn shadow_only(&self, which: &[bool], ws: &mut Workspace) {
+        self.shadow_with(None, Some(which), ws)
+    }
+
     /// [`Problem::shadow`] of the occluders in `which` only, drawn over `start` (a held
     /// shadow; OR is order-free, so the mask is the same as drawing everything).
     fn shadow_with(&self, start: Option<&Mask>, which: Option<&[bool]>, ws: &mut Workspace) {

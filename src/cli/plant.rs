@@ -1,0 +1,120 @@
+//! `bsa plant`: a problem with a known answer ([`crate::design::plant`]): the scene, its
+//! target (the shadow of a random contact-free launch) and that launch.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+
+use crate::design::inventory::{self, Item};
+use crate::design::plant::{self, Layout, Stage};
+use crate::energy::Weights;
+use crate::evaluate::Problem;
+use crate::output::{files, picture};
+use crate::scene::Launch;
+use crate::shadow::mask::Mask;
+
+use super::{load, PlantArgs};
+
+/// Draws before `bsa plant` gives up on an inventory.
+const ATTEMPTS: usize = 2000;
+
+/// The validated options of `bsa plant`.
+pub(super) struct Options {
+    dir: PathBuf,
+    items: Vec<Item>,
+    seed: u64,
+    stage: Stage,
+}
+
+impl Options {
+    pub(super) fn new(args: PlantArgs) -> Result<Options> {
+        let items = inventory::parse(&args.objects).context("--objects")?;
+        for (name, value, lo, hi) in [
+            ("--width", args.width, 0.01, 1000.0),
+            ("--light-height", args.light_height, 0.1, 1000.0),
+            ("--t", args.t, 0.05, 60.0),
+        ] {
+            if !(value.is_finite() && value >= lo && value <= hi) {
+                bail!("{name} must be between {lo} and {hi}, got {value}");
+            }
+        }
+        Ok(Options {
+            dir: args.dir,
+            items,
+            seed: args.seed,
+            stage: Stage {
+                picture_width: args.width,
+                light_height: args.light_height,
+                t: args.t,
+                ..Stage::default()
+            },
+        })
+    }
+}
+
+pub(super) fn run(opts: &Options) -> Result<()> {
+    let layout = Layout::new(opts.stage.clone(), &opts.items)?;
+    let dir = &opts.dir;
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let name = dir
+        .file_name()
+        .and_then(|s| s.to_str())
+        .unwrap_or("planted")
+        .to_string();
+    let (w, h) = opts.stage.pixels;
+    // The scene needs a target to load: a placeholder until the draw gives the real one.
+    let placeholder = Mask::from_fn(w, h, |x, y| x == w / 2 && y == h / 2);
+    write_target(dir, &placeholder)?;
+    let scene_file = dir.join("scene.json");
+    let write_scene = |hints: &[(usize, glam::DVec2)]| -> Result<()> {
+        let json = layout.scene_json(&name, "target.png", hints, opts.seed);
+        files::write_atomic(&scene_file, serde_json::to_string_pretty(&json)?.as_bytes())?;
+        Ok(())
+    };
+    write_scene(&[])?;
+    let problem = Problem::new(load::scene(dir)?);
+    let params = plant::draw_launch(&problem, opts.seed, ATTEMPTS)?;
+    let mut ws = problem.workspace();
+    problem.evaluate(&params, &Weights::default(), &mut ws);
+    let target = ws.mask.clone();
+    write_target(dir, &target)?;
+    let hints = plant::hints(&problem, &target);
+    write_scene(&hints)?;
+    // The planted launch, as a launch file `bsa render` reads.
+    let scene = &problem.scene;
+    let mut launch = serde_json::Map::new();
+    for (i, o) in scene.occluders.iter().enumerate() {
+        let l = Launch::get(&params, i);
+        launch.insert(
+            o.name.clone(),
+            serde_json::json!({"velocity": l.velocity.to_array(), "angular_velocity": l.angular_velocity.to_array()}),
+        );
+    }
+    files::write_atomic(
+        &dir.join("planted.json"),
+        serde_json::to_string_pretty(&launch)?.as_bytes(),
+    )?;
+    // The scene as a user gets it: loads, and its start guess aimed at the hints.
+    let problem = Problem::new(load::scene(dir)?);
+    let start = problem.evaluate(
+        &problem.scene.start_parameters(),
+        &Weights::default(),
+        &mut ws,
+    );
+    println!(
+        "{}: {} objects, target {} shadow pixels; the planted launch (IoU 1) is in {}; start guess IoU {:.4}; wrote {}/{{scene.json, target.png, planted.json}}",
+        name,
+        layout.len(),
+        target.count(),
+        dir.join("planted.json").display(),
+        start.iou,
+        dir.display()
+    );
+    Ok(())
+}
+
+fn write_target(dir: &std::path::Path, mask: &Mask) -> Result<()> {
+    let img = picture::mask_image(mask.width(), mask.height(), &|x, y| mask.get(x, y));
+    files::save_png(&img, &dir.join("target.png"))?;
+    Ok(())
+}

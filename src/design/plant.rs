@@ -1,0 +1,339 @@
+//! Planted problems: a random launch of a box of objects whose shadow at `t` becomes the
+//! target, so that a perfect answer exists by construction. They measure the solver on
+//! problems nobody tuned it for (`bsa plant`, `scripts/planted-suite.sh`).
+//!
+//! Data flow: [`Layout`] places the objects on the floor in front of the picture and
+//! writes the scene file ([`Layout::scene_json`]); once that scene is loaded (with a
+//! placeholder target), [`draw_launch`] draws launches until one is contact-free, casts
+//! every shadow inside the picture and leaves each object's shadow visible; its shadow is
+//! the target; [`hints`] then places one hint per object the way a user would, from the
+//! target alone: each object's centre to the centroid of a blob, objects and blobs
+//! matched by size.
+
+use glam::{DVec2, DVec3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde_json::{json, Value};
+
+use super::inventory::{Item, Kind};
+use crate::energy::Weights;
+use crate::evaluate::Problem;
+use crate::geometry::shape::{load_obj, ObjError};
+use crate::scene::Launch;
+use crate::shadow::mask::Mask;
+
+/// The stage of a planted (or designed) scene: what `bsa plant` and `bsa new` lay out.
+#[derive(Clone, Debug)]
+pub struct Stage {
+    /// Width of the picture on the floor (m); its height is 3/4 of it.
+    pub picture_width: f64,
+    /// Height of the point light above the picture's centre (m).
+    pub light_height: f64,
+    /// The instant of the picture (s).
+    pub t: f64,
+    /// Target size in pixels.
+    pub pixels: (usize, usize),
+}
+
+impl Default for Stage {
+    fn default() -> Stage {
+        Stage {
+            picture_width: 1.6,
+            light_height: 6.0,
+            t: 1.2,
+            pixels: (640, 480),
+        }
+    }
+}
+
+/// Why a problem cannot be planted.
+#[derive(Debug, thiserror::Error)]
+pub enum PlantError {
+    /// An OBJ of the inventory cannot be used.
+    #[error("cannot use the mesh {path}")]
+    Mesh {
+        path: String,
+        #[source]
+        source: ObjError,
+    },
+    /// No draw met the conditions.
+    #[error("no launch in {attempts} draws keeps these {objects} objects clear of each other with every shadow inside the picture and visible: the inventory does not fit in a {width} m picture (use fewer or smaller objects, or a wider picture)")]
+    NoFit {
+        attempts: usize,
+        objects: usize,
+        width: f64,
+    },
+}
+
+/// The objects of an inventory placed on the floor, ready to be written as a scene.
+#[derive(Clone, Debug)]
+pub struct Layout {
+    pub stage: Stage,
+    /// (name, shape JSON, launch position, density) per object.
+    objects: Vec<(String, Value, DVec3, f64)>,
+}
+
+impl Layout {
+    /// Place `items` in rows on the floor, in front of the picture (negative y), each
+    /// resting on it.
+    pub fn new(stage: Stage, items: &[Item]) -> Result<Layout, PlantError> {
+        let h = 0.75 * stage.picture_width;
+        let mut objects = Vec::new();
+        let (mut x, mut y, mut row_depth) = (0.0f64, -(0.5 * h + 0.5), 0.0f64);
+        let row_length = 2.0 * stage.picture_width;
+        let mut counts = std::collections::HashMap::new();
+        let (mut rows, mut row) = (Vec::new(), 0usize);
+        for item in items {
+            // Footprint (x, y extent) and the height of the origin above the floor.
+            let (shape, foot, lift, stem) = match &item.kind {
+                Kind::Sphere { radius } => (
+                    json!({"sphere": {"radius": radius}}),
+                    DVec2::splat(2.0 * radius),
+                    *radius,
+                    "sphere".to_string(),
+                ),
+                Kind::Box { size } => (
+                    json!({"box": {"size": size}}),
+                    DVec2::new(size[0], size[1]),
+                    0.5 * size[2],
+                    "box".to_string(),
+                ),
+                Kind::Mesh { obj, scale } => {
+                    let mesh = load_obj(obj, *scale).map_err(|source| PlantError::Mesh {
+                        path: obj.display().to_string(),
+                        source,
+                    })?;
+                    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+                    for v in &mesh.vertices {
+                        lo = lo.min(*v);
+                        hi = hi.max(*v);
+                    }
+                    let abs = std::fs::canonicalize(obj).unwrap_or_else(|_| obj.clone());
+                    (
+                        json!({"mesh": {"obj": abs.display().to_string(), "scale": scale}}),
+                        (hi - lo).truncate(),
+                        -lo.z,
+                        obj.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh").to_string(),
+                    )
+                }
+            };
+            let n = counts.entry(stem.clone()).or_insert(0);
+            *n += 1;
+            let name = format!("{stem}_{n}");
+            let gap = 0.05;
+            if x > 0.0 && x + foot.x > row_length {
+                x = 0.0;
+                y -= row_depth + gap;
+                row_depth = 0.0;
+                row += 1;
+            }
+            let cx = x + 0.5 * foot.x;
+            x += foot.x + gap;
+            row_depth = row_depth.max(foot.y);
+            // Rows are centred afterwards; y is the row's front edge.
+            objects.push((name, shape, DVec3::new(cx, y - 0.5 * foot.y, lift + 1e-6), item.density));
+            rows.push(row);
+        }
+        // Centre every row on x = 0.
+        for r in 0..=row {
+            let members: Vec<usize> = (0..objects.len()).filter(|&j| rows[j] == r).collect();
+            let (lo, hi) = members.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &j| {
+                (a.min(objects[j].2.x), b.max(objects[j].2.x))
+            });
+            for &j in &members {
+                objects[j].2.x -= 0.5 * (lo + hi);
+            }
+        }
+        Ok(Layout { stage, objects })
+    }
+
+    /// Number of objects.
+    pub fn len(&self) -> usize {
+        self.objects.len()
+    }
+
+    /// Whether there are no objects.
+    pub fn is_empty(&self) -> bool {
+        self.objects.is_empty()
+    }
+
+    /// The scene file: geometry, the objects, the target file `target`, `hints` as
+    /// (occluder index, pixel) pairs, and the default strategy for this many objects.
+    pub fn scene_json(&self, name: &str, target: &str, hints: &[(usize, DVec2)], seed: u64) -> Value {
+        let s = &self.stage;
+        let occluders: Vec<Value> = self
+            .objects
+            .iter()
+            .map(|(name, shape, p, density)| {
+                json!({"name": name, "shape": shape, "position": [p.x, p.y, p.z], "density": density})
+            })
+            .collect();
+        let hints: Vec<Value> = hints
+            .iter()
+            .map(|(i, px)| {
+                json!({"occluder": self.objects[*i].0, "point": [0.0, 0.0, 0.0], "pixel": [px.x, px.y]})
+            })
+            .collect();
+        let mut scene = json!({
+            "name": name,
+            "target": target,
+            "t": s.t,
+            "light": [0.0, 0.0, s.light_height],
+            "receiver": {"center": [0.0, 0.0, 0.0], "u": [1.0, 0.0, 0.0], "v": [0.0, 1.0, 0.0],
+                         "width": s.picture_width, "height": 0.75 * s.picture_width},
+            "table": {"center": [0.0, 0.0, -0.5], "size": [40.0, 40.0, 1.0]},
+            "occluders": occluders,
+            "seed": seed,
+        });
+        if !hints.is_empty() {
+            scene["hints"] = Value::from(hints);
+        }
+        scene["strategy"] = default_strategy(self.objects.len());
+        scene
+    }
+}
+
+/// The strategy a designed scene gets: one object at a time, then all together (for
+/// more than four objects, the pass one at a time runs twice).
+pub fn default_strategy(objects: usize) -> Value {
+    let weights = json!({"xor": 1.0, "hint": 0.3, "barrier": 1.0, "contact": 100000.0, "reg": 0.01});
+    if objects <= 4 {
+        return json!({"kind": "sequential", "order": "auto", "rounds": 1,
+            "stage": {"weights": weights, "step": 0.1, "population": 24, "max_iterations": 100, "stagnation": 30},
+            "final": {"weights": weights, "step": 0.05, "population": 32, "max_iterations": 150, "stagnation": 40}});
+    }
+    json!({"kind": "sequential", "order": "auto", "rounds": 2,
+        "stage": {"weights": weights, "step": 0.05, "population": 24, "max_iterations": 100, "stagnation": 25},
+        "final": {"weights": weights, "step": 0.02, "population": 32, "max_iterations": 100, "stagnation": 25}})
+}
+
+/// Draw launches for every launched occluder of `problem` until one flies clear of
+/// everything, casts every shadow inside the picture and leaves each object at least
+/// a third of its own shadow visible. Each occluder is sent through a random point of
+/// the picture's central part, at a random height between a fifth and a half of the
+/// light's, with a random spin of up to 4 rad/s.
+pub fn draw_launch(problem: &Problem, seed: u64, attempts: usize) -> Result<Vec<f64>, PlantError> {
+    let scene = &problem.scene;
+    let cam = &scene.camera;
+    let n = scene.occluders.len();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut ws = problem.workspace();
+    let mut params = vec![0.0; scene.variable_count()];
+    let light = cam.light;
+    let t = scene.t;
+    for _ in 0..attempts {
+        for (i, o) in scene.occluders.iter().enumerate() {
+            if !o.launched {
+                continue;
+            }
+            let px = rng.random_range(0.15..0.85) * cam.width_px as f64;
+            let py = rng.random_range(0.15..0.85) * cam.height_px as f64;
+            let on_plane = cam.pixel_to_world(px, py);
+            let s = rng.random_range(0.2..0.5);
+            let com_t = on_plane + s * (light - on_plane);
+            let com0 = o.launch_com();
+            let v = (com_t - com0 - 0.5 * scene.gravity * t * t) / t;
+            let axis = DVec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            )
+            .normalize_or_zero();
+            let w = axis * rng.random_range(0.5..4.0);
+            Launch {
+                velocity: v,
+                angular_velocity: w,
+            }
+            .set(&mut params, i);
+        }
+        let e = problem.evaluate(&params, &Weights::default(), &mut ws);
+        if e.outcome.n_contacts > 0 || !problem.shadows_in_image(&ws).iter().all(|&b| b) {
+            continue;
+        }
+        let full = ws.mask.count();
+        let visible = (0..n).all(|i| {
+            let mut only = vec![false; n];
+            only[i] = true;
+            problem.shadow_only(&only, &mut ws);
+            let alone = ws.mask.count();
+            let mut others: Vec<bool> = vec![true; n];
+            others[i] = false;
+            problem.shadow_only(&others, &mut ws);
+            let rest = ws.mask.count();
+            alone > 0 && (full - rest) as f64 >= alone as f64 / 3.0
+        });
+        if visible {
+            return Ok(params);
+        }
+    }
+    Err(PlantError::NoFit {
+        attempts,
+        objects: n,
+        width: scene.receiver.width,
+    })
+}
+
+/// One hint per object from the target alone, as a user would place them: the target's
+/// blobs (4-connected) and the objects are each sorted by size (blob area, object
+/// volume), and each object in turn takes the blob with the most area per object already
+/// on it; its hint sends its centre to that blob's centroid.
+pub fn hints(problem: &Problem, target: &Mask) -> Vec<(usize, DVec2)> {
+    let blobs = blobs(target);
+    if blobs.is_empty() {
+        return Vec::new();
+    }
+    let occ = &problem.scene.occluders;
+    let mut order: Vec<usize> = (0..occ.len()).filter(|&i| occ[i].launched).collect();
+    order.sort_by(|&a, &b| occ[b].shape.volume().total_cmp(&occ[a].shape.volume()).then(a.cmp(&b)));
+    let mut taken = vec![0usize; blobs.len()];
+    let mut out = Vec::new();
+    for i in order {
+        let k = (0..blobs.len())
+            .max_by(|&a, &b| {
+                let share = |k: usize| blobs[k].0 as f64 / (1 + taken[k]) as f64;
+                share(a).total_cmp(&share(b)).then(b.cmp(&a))
+            })
+            .expect("at least one blob");
+        taken[k] += 1;
+        out.push((i, blobs[k].1));
+    }
+    out.sort_by_key(|h| h.0);
+    out
+}
+
+/// The 4-connected components of a mask: (pixel count, centroid in pixel coordinates).
+fn blobs(mask: &Mask) -> Vec<(usize, DVec2)> {
+    let (w, h) = (mask.width(), mask.height());
+    let mut label = vec![usize::MAX; w * h];
+    let mut out = Vec::new();
+    let mut stack = Vec::new();
+    for y0 in 0..h {
+        for x0 in 0..w {
+            if !mask.get(x0, y0) || label[y0 * w + x0] != usize::MAX {
+                continue;
+            }
+            let id = out.len();
+            let (mut count, mut sum) = (0usize, DVec2::ZERO);
+            label[y0 * w + x0] = id;
+            stack.push((x0, y0));
+            while let Some((x, y)) = stack.pop() {
+                count += 1;
+                sum += DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+                let near = [
+                    (x.wrapping_sub(1), y),
+                    (x + 1, y),
+                    (x, y.wrapping_sub(1)),
+                    (x, y + 1),
+                ];
+                for (nx, ny) in near {
+                    if nx < w && ny < h && mask.get(nx, ny) && label[ny * w + nx] == usize::MAX {
+                        label[ny * w + nx] = id;
+                        stack.push((nx, ny));
+                    }
+                }
+            }
+            out.push((count, sum / count as f64));
+        }
+    }
+    out
+}
