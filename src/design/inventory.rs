@@ -15,10 +15,17 @@ pub const MAX_OBJECTS: usize = 64;
 /// One object's shape.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Kind {
-    Sphere { radius: f64 },
-    Box { size: [f64; 3] },
+    Sphere {
+        radius: f64,
+    },
+    Box {
+        size: [f64; 3],
+    },
     /// An OBJ file, scaled.
-    Mesh { obj: PathBuf, scale: f64 },
+    Mesh {
+        obj: PathBuf,
+        scale: f64,
+    },
 }
 
 /// One object of the box.
@@ -75,7 +82,9 @@ pub fn parse(list: &str) -> Result<Vec<Item>, InventoryError> {
             if x.is_finite() && x > 0.0 && x <= 1e3 {
                 Ok(x)
             } else {
-                Err(bad(format!("{what} must be positive and at most 1000, got {s}")))
+                Err(bad(format!(
+                    "{what} must be positive and at most 1000, got {s}"
+                )))
             }
         };
         // kind:spec[*N][/DENSITY]: a trailing `/number` is the density (a mesh path may
@@ -165,7 +174,8 @@ mod tests {
 
     #[test]
     fn counts_densities_and_scales_are_read() {
-        let items = parse("box:0.14x0.07x0.035*2/600, sphere:0.1, mesh:pieces/pawn.obj@2*3").unwrap();
+        let items =
+            parse("box:0.14x0.07x0.035*2/600, sphere:0.1, mesh:pieces/pawn.obj@2*3").unwrap();
         assert_eq!(items.len(), 6);
         assert_eq!(
             items[0],

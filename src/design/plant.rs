@@ -103,7 +103,8 @@ impl Layout {
                         path: obj.display().to_string(),
                         source,
                     })?;
-                    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+                    let (mut lo, mut hi) =
+                        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
                     for v in &mesh.vertices {
                         lo = lo.min(*v);
                         hi = hi.max(*v);
@@ -113,7 +114,10 @@ impl Layout {
                         json!({"mesh": {"obj": abs.display().to_string(), "scale": scale}}),
                         (hi - lo).truncate(),
                         -lo.z,
-                        obj.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh").to_string(),
+                        obj.file_stem()
+                            .and_then(|s| s.to_str())
+                            .unwrap_or("mesh")
+                            .to_string(),
                     )
                 }
             };
@@ -131,15 +135,22 @@ impl Layout {
             x += foot.x + gap;
             row_depth = row_depth.max(foot.y);
             // Rows are centred afterwards; y is the row's front edge.
-            objects.push((name, shape, DVec3::new(cx, y - 0.5 * foot.y, lift + 1e-6), item.density));
+            objects.push((
+                name,
+                shape,
+                DVec3::new(cx, y - 0.5 * foot.y, lift + 1e-6),
+                item.density,
+            ));
             rows.push(row);
         }
         // Centre every row on x = 0.
         for r in 0..=row {
             let members: Vec<usize> = (0..objects.len()).filter(|&j| rows[j] == r).collect();
-            let (lo, hi) = members.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &j| {
-                (a.min(objects[j].2.x), b.max(objects[j].2.x))
-            });
+            let (lo, hi) = members
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &j| {
+                    (a.min(objects[j].2.x), b.max(objects[j].2.x))
+                });
             for &j in &members {
                 objects[j].2.x -= 0.5 * (lo + hi);
             }
@@ -159,7 +170,13 @@ impl Layout {
 
     /// The scene file: geometry, the objects, the target file `target`, `hints` as
     /// (occluder index, pixel) pairs, and the default strategy for this many objects.
-    pub fn scene_json(&self, name: &str, target: &str, hints: &[(usize, DVec2)], seed: u64) -> Value {
+    pub fn scene_json(
+        &self,
+        name: &str,
+        target: &str,
+        hints: &[(usize, DVec2)],
+        seed: u64,
+    ) -> Value {
         let s = &self.stage;
         let occluders: Vec<Value> = self
             .objects
@@ -196,7 +213,8 @@ impl Layout {
 /// The strategy a designed scene gets: one object at a time, then all together (for
 /// more than four objects, the pass one at a time runs twice).
 pub fn default_strategy(objects: usize) -> Value {
-    let weights = json!({"xor": 1.0, "hint": 0.3, "barrier": 1.0, "contact": 100000.0, "reg": 0.01});
+    let weights =
+        json!({"xor": 1.0, "hint": 0.3, "barrier": 1.0, "contact": 100000.0, "reg": 0.01});
     if objects <= 4 {
         return json!({"kind": "sequential", "order": "auto", "rounds": 1,
             "stage": {"weights": weights, "step": 0.1, "population": 24, "max_iterations": 100, "stagnation": 30},
@@ -284,7 +302,13 @@ pub fn hints(problem: &Problem, target: &Mask) -> Vec<(usize, DVec2)> {
     }
     let occ = &problem.scene.occluders;
     let mut order: Vec<usize> = (0..occ.len()).filter(|&i| occ[i].launched).collect();
-    order.sort_by(|&a, &b| occ[b].shape.volume().total_cmp(&occ[a].shape.volume()).then(a.cmp(&b)));
+    order.sort_by(|&a, &b| {
+        occ[b]
+            .shape
+            .volume()
+            .total_cmp(&occ[a].shape.volume())
+            .then(a.cmp(&b))
+    });
     let mut taken = vec![0usize; blobs.len()];
     let mut out = Vec::new();
     for i in order {

@@ -24,6 +24,7 @@ pub(super) struct RawScene {
     pub(super) stages: Option<Vec<RawStage>>,
     pub(super) strategy: Option<RawStrategy>,
     pub(super) seed: Option<u64>,
+    pub(super) contacts: Option<String>,
 }
 
 #[derive(Deserialize)]

@@ -195,6 +195,16 @@ impl Validator<'_> {
             }
         }
         let (stages, strategy) = self.stages(&raw, &occluders)?;
+        let contacts = match raw.contacts.as_deref() {
+            Some("constraint") => Contacts::Constraint,
+            None | Some("penalty") => Contacts::Penalty,
+            Some(other) => {
+                return Err(self.field_err(
+                    "contacts",
+                    format!("must be \"constraint\" or \"penalty\", got \"{other}\""),
+                ))
+            }
+        };
         Ok(Scene {
             name,
             source: self.file.to_path_buf(),
@@ -211,6 +221,7 @@ impl Validator<'_> {
             stages,
             strategy,
             seed: raw.seed.unwrap_or(1),
+            contacts,
         })
     }
 
