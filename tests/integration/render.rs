@@ -126,3 +126,46 @@ fn bad_launch_files_name_the_file_and_the_entry() {
         }
     }
 }
+
+#[test]
+fn a_planted_problem_is_solvable_by_its_planted_launch() {
+    let d = tmpdir("plant");
+    let dir = d.join("three");
+    let (ok, out, err) = bsa(&[
+        "plant",
+        dir.to_str().unwrap(),
+        "--objects",
+        "sphere:0.15,sphere:0.2*2",
+        "--seed",
+        "5",
+        "--width",
+        "4",
+    ]);
+    assert!(ok && out.contains("3 objects"), "{err}");
+    let scene = std::fs::read_to_string(dir.join("scene.json")).unwrap();
+    assert!(scene.contains("\"hints\""), "{scene}");
+    let (ok, out, err) = render(&dir, &dir.join("planted.json"), &d.join("render"));
+    assert!(ok && out.contains("IoU at 1.2 s 1.0000"), "{out} {err}");
+    assert!(out.contains("no contact before t"), "{out}");
+}
+
+#[test]
+fn plant_refuses_bad_inventories_and_ones_that_cannot_fit() {
+    let d = tmpdir("plant-bad");
+    for (objects, extra, expect) in [
+        ("cone:1", vec![], "unknown kind `cone`"),
+        ("sphere:0.1,box:1x2", vec![], "item 2"),
+        ("mesh:/nonexistent.obj", vec![], "/nonexistent.obj"),
+        ("sphere:0.5*8", vec!["--width", "1"], "does not fit"),
+    ] {
+        let dir = d.join("p");
+        let mut args = vec!["plant", dir.to_str().unwrap(), "--objects", objects];
+        args.extend(extra);
+        let (ok, _, err) = bsa(&args);
+        assert!(!ok && !err.contains("panicked"), "{objects}: {err}");
+        assert!(
+            err.contains(expect),
+            "{objects}: expected `{expect}` in: {err}"
+        );
+    }
+}
