@@ -22,6 +22,7 @@ mod check;
 mod eval;
 mod export;
 mod load;
+mod new;
 mod plant;
 mod progress;
 mod render;
@@ -73,6 +74,10 @@ enum Command {
     /// objects whose shadow becomes the target; writes scene.json, target.png and
     /// planted.json (the launch) into DIR.
     Plant(PlantArgs),
+    /// Design a scene from a picture and a box of objects: writes DIR/scene.json (objects
+    /// laid out, hints, start guess, strategy), DIR/target.png and DIR/start.png (the
+    /// start guess over the target), ready for `bsa solve DIR`.
+    New(NewArgs),
 }
 
 // Raw arguments of `bsa check`.
@@ -248,6 +253,47 @@ struct RenderArgs {
     at: Option<f64>,
 }
 
+// Raw arguments of `bsa new`.
+#[derive(Args)]
+struct NewArgs {
+    /// Folder to write the scene into (created if needed).
+    dir: PathBuf,
+    /// The picture (PNG; dark = shadow).
+    #[arg(long, value_name = "PNG")]
+    target: PathBuf,
+    /// The objects: comma-separated sphere:R, box:XxYxZ or mesh:FILE.obj[@SCALE], each
+    /// with an optional *N count and /DENSITY (metres, kg/m^3; default 705, maple).
+    #[arg(long)]
+    objects: String,
+    /// The picture's width on the floor (m); its height follows the picture's aspect.
+    #[arg(
+        long,
+        value_name = "M",
+        default_value_t = 1.6,
+        allow_negative_numbers = true
+    )]
+    width: f64,
+    /// The point light's height above the picture (m).
+    #[arg(
+        long,
+        value_name = "M",
+        default_value_t = 6.0,
+        allow_negative_numbers = true
+    )]
+    light_height: f64,
+    /// The instant of the picture (s after the launch).
+    #[arg(
+        long,
+        value_name = "S",
+        default_value_t = 1.2,
+        allow_negative_numbers = true
+    )]
+    t: f64,
+    /// Seed of the scene's solve.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
 // Raw arguments of `bsa plant`.
 #[derive(Args)]
 struct PlantArgs {
@@ -261,13 +307,28 @@ struct PlantArgs {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// The picture's width on the floor (m); its height is 3/4 of it.
-    #[arg(long, value_name = "M", default_value_t = 1.6)]
+    #[arg(
+        long,
+        value_name = "M",
+        default_value_t = 1.6,
+        allow_negative_numbers = true
+    )]
     width: f64,
     /// The point light's height above the picture (m).
-    #[arg(long, value_name = "M", default_value_t = 6.0)]
+    #[arg(
+        long,
+        value_name = "M",
+        default_value_t = 6.0,
+        allow_negative_numbers = true
+    )]
     light_height: f64,
     /// The instant of the picture (s after the launch).
-    #[arg(long, value_name = "S", default_value_t = 1.2)]
+    #[arg(
+        long,
+        value_name = "S",
+        default_value_t = 1.2,
+        allow_negative_numbers = true
+    )]
     t: f64,
 }
 
@@ -283,5 +344,6 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Budget(args) => budget::run(&budget::Options::new(args)),
         Command::Render(args) => render::run(&render::Options::new(args)?),
         Command::Plant(args) => plant::run(&plant::Options::new(args)?),
+        Command::New(args) => new::run(&new::Options::new(args)?),
     }
 }

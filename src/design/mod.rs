@@ -2,5 +2,6 @@
 //! and [`plant`] (problems with a known answer: a random contact-free launch whose
 //! shadow becomes the target).
 
+pub mod cover;
 pub mod inventory;
 pub mod plant;

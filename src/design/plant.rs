@@ -25,7 +25,7 @@ use crate::shadow::mask::Mask;
 /// The stage of a planted (or designed) scene: what `bsa plant` and `bsa new` lay out.
 #[derive(Clone, Debug)]
 pub struct Stage {
-    /// Width of the picture on the floor (m); its height is 3/4 of it.
+    /// Width of the picture on the floor (m); its height follows the target's aspect.
     pub picture_width: f64,
     /// Height of the point light above the picture's centre (m).
     pub light_height: f64,
@@ -43,6 +43,13 @@ impl Default for Stage {
             t: 1.2,
             pixels: (640, 480),
         }
+    }
+}
+
+impl Stage {
+    /// Height of the picture on the floor (m), from the target's aspect ratio.
+    pub fn picture_height(&self) -> f64 {
+        self.picture_width * self.pixels.1 as f64 / self.pixels.0 as f64
     }
 }
 
@@ -77,7 +84,7 @@ impl Layout {
     /// Place `items` in rows on the floor, in front of the picture (negative y), each
     /// resting on it.
     pub fn new(stage: Stage, items: &[Item]) -> Result<Layout, PlantError> {
-        let h = 0.75 * stage.picture_width;
+        let h = stage.picture_height();
         let mut objects = Vec::new();
         let (mut x, mut y, mut row_depth) = (0.0f64, -(0.5 * h + 0.5), 0.0f64);
         let row_length = 2.0 * stage.picture_width;
@@ -197,7 +204,7 @@ impl Layout {
             "t": s.t,
             "light": [0.0, 0.0, s.light_height],
             "receiver": {"center": [0.0, 0.0, 0.0], "u": [1.0, 0.0, 0.0], "v": [0.0, 1.0, 0.0],
-                         "width": s.picture_width, "height": 0.75 * s.picture_width},
+                         "width": s.picture_width, "height": s.picture_height()},
             "table": {"center": [0.0, 0.0, -0.5], "size": [40.0, 40.0, 1.0]},
             "occluders": occluders,
             "seed": seed,

@@ -169,3 +169,71 @@ fn plant_refuses_bad_inventories_and_ones_that_cannot_fit() {
         );
     }
 }
+
+#[test]
+fn new_designs_a_scene_that_solve_takes_as_it_is() {
+    let d = tmpdir("new");
+    let dir = d.join("mickey");
+    let target = root().join("scenes/mickey/target.png");
+    let (ok, out, err) = bsa(&[
+        "new",
+        dir.to_str().unwrap(),
+        "--target",
+        target.to_str().unwrap(),
+        "--objects",
+        "sphere:0.6,sphere:0.35*2",
+        "--width",
+        "4",
+    ]);
+    assert!(ok && out.contains("start guess IoU"), "{err}");
+    for f in ["scene.json", "target.png", "start.png"] {
+        assert!(dir.join(f).is_file(), "{f}");
+    }
+    let (ok, _, err) = bsa(&["check", dir.to_str().unwrap()]);
+    assert!(ok, "{err}");
+}
+
+#[test]
+fn new_refuses_pictures_objects_and_options_it_cannot_use() {
+    let d = tmpdir("new-bad");
+    let blank = d.join("blank.png");
+    image::GrayImage::from_pixel(64, 48, image::Luma([255]))
+        .save(&blank)
+        .unwrap();
+    let mickey = root().join("scenes/mickey/target.png");
+    let m = mickey.to_str().unwrap();
+    for (target, objects, extra, expect) in [
+        (
+            blank.to_str().unwrap(),
+            "sphere:0.1",
+            vec![],
+            "no dark pixel",
+        ),
+        (m, "sphere:5", vec![], "larger than the"),
+        (m, "cube:1", vec![], "unknown kind `cube`"),
+        (
+            m,
+            "sphere:0.1",
+            vec!["--light-height", "-1"],
+            "--light-height",
+        ),
+        ("/nonexistent.png", "sphere:0.1", vec![], "/nonexistent.png"),
+    ] {
+        let dir = d.join("s");
+        let mut args = vec![
+            "new",
+            dir.to_str().unwrap(),
+            "--target",
+            target,
+            "--objects",
+            objects,
+        ];
+        args.extend(extra);
+        let (ok, _, err) = bsa(&args);
+        assert!(!ok && !err.contains("panicked"), "{objects}: {err}");
+        assert!(
+            err.contains(expect),
+            "{objects}: expected `{expect}` in: {err}"
+        );
+    }
+}
