@@ -20,6 +20,7 @@ mod budget;
 mod check;
 mod eval;
 mod export;
+pub mod guard;
 mod load;
 mod progress;
 mod solve;
