@@ -159,9 +159,9 @@ impl Drop for OutputGuard {
     }
 }
 
-/// A solution file that parses and says it is complete.
+/// A solution file that parses and has run all its stages.
 fn is_complete(path: &Path) -> bool {
-    path.exists() && files::read_solution(path).is_ok_and(|s| s.complete)
+    path.exists() && files::read_solution(path).is_ok_and(|s| s.stages_completed >= s.stages_total)
 }
 
 /// Create the lock file, or explain who holds it.

@@ -77,7 +77,8 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let guard = guard::OutputGuard::acquire(&out, opts.resume, needed)?;
     let result = solve_into(opts, &problem, &out, guard.has_previous(), clock);
     let incomplete = match &result {
-        Ok(solution) => !solution.complete,
+        // A stage shortened by one Ctrl-C still counts as run: the user chose to end it.
+        Ok(solution) => solution.stages_completed < solution.stages_total,
         Err(_) => true,
     };
     if !incomplete {
@@ -178,7 +179,7 @@ fn solve_into(
     all.extend(records);
     files::write_convergence_plot(&out, &observer.stage_names, &all)?;
     clock.lap("solution, convergence table and plot");
-    if keep_previous && !solution.complete {
+    if keep_previous && solution.stages_completed < solution.stages_total {
         return Ok(solution);
     }
     let mut ws = problem.workspace();
