@@ -2,7 +2,9 @@
 //! against `bsa check` and, for a subset that check accepts, a short `bsa solve`, each
 //! under a timeout. Every field of a scene that uses every optional field (a sphere, a
 //! box and a mesh occluder, table, hints, start, two stages) is given a wrong type, is
-//! removed, and is set to 0, -1, 1e300 and -1e300; every array is also made huge. The
+//! removed, and is set to 0, -1, 1e300, -1e300, 1e-300 and 1e12; every array is also
+//! made huge. `fuzz_obj_and_png_bytes_are_handled_cleanly` does the same for the bytes of
+//! the OBJ and PNG readers (seeded flips, truncations, garbage lines). The
 //! cases are enumerated in a fixed order, so a failure names a case that can be rerun.
 //!
 //! "Handled cleanly" means: the process ended by itself within the timeout, with exit
@@ -179,6 +181,8 @@ fn cases(base: &Value) -> Vec<(String, Value, bool)> {
             Mutation::Value(-1.0),
             Mutation::Value(1e300),
             Mutation::Value(-1e300),
+            Mutation::Value(1e-300),
+            Mutation::Value(1e12),
         ];
         let is_array = {
             let mut v = base.clone();
@@ -342,6 +346,94 @@ fn fuzz_scene_mutations_are_handled_cleanly() {
         solves.len()
     );
     assert!(cases.len() >= 500, "only {} cases", cases.len());
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A small deterministic generator (SplitMix64), so that every run tries the same bytes.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+}
+
+/// A mutation of `bytes`: a few flipped bytes, a truncation, or inserted garbage.
+fn mutate_bytes(rng: &mut Rng, bytes: &[u8]) -> Vec<u8> {
+    let mut b = bytes.to_vec();
+    match rng.below(4) {
+        0 => {
+            for _ in 0..1 + rng.below(8) {
+                let i = rng.below(b.len());
+                b[i] = rng.next() as u8;
+            }
+        }
+        1 => b.truncate(rng.below(b.len())),
+        2 => {
+            let garbage: &[&[u8]] = &[
+                b"v 1e39 0 0\n",
+                b"f 1 2 99999\n",
+                b"f -1 -2 -3\n",
+                b"v nan nan nan\n",
+                b"f 1 1 1\n",
+                b"\xff\xfe\n",
+                b"f 0 1 2\n",
+            ];
+            let g = garbage[rng.below(garbage.len())];
+            let i = rng.below(b.len());
+            b.splice(i..i, g.iter().copied());
+        }
+        _ => {
+            let i = rng.below(b.len());
+            let j = (i + rng.below(64)).min(b.len());
+            b.drain(i..j);
+        }
+    }
+    b
+}
+
+#[test]
+fn fuzz_obj_and_png_bytes_are_handled_cleanly() {
+    let dir = tmpdir("fuzz-bytes");
+    let png = std::fs::read(root().join("scenes/mickey/target.png")).unwrap();
+    let mut scene = base_scene();
+    scene["occluders"][2]["shape"]["mesh"]["obj"] = "m.obj".into();
+    let mut rng = Rng(13);
+    let mut failures = Vec::new();
+    let cases = 150;
+    for i in 0..cases {
+        let case = dir.join(format!("b{i}"));
+        std::fs::create_dir_all(&case).unwrap();
+        let (obj, target) = if i % 2 == 0 {
+            (mutate_bytes(&mut rng, CUBE_OBJ.as_bytes()), png.clone())
+        } else {
+            (CUBE_OBJ.as_bytes().to_vec(), mutate_bytes(&mut rng, &png))
+        };
+        std::fs::write(case.join("m.obj"), obj).unwrap();
+        std::fs::write(case.join("target.png"), target).unwrap();
+        std::fs::write(case.join("scene.json"), scene.to_string()).unwrap();
+        if let Outcome::Unclean(why) = run(
+            &["check", case.to_str().unwrap()],
+            &case,
+            "check",
+            CHECK_TIMEOUT,
+        ) {
+            failures.push(format!("bytes case {i}: {why}"));
+        }
+    }
+    println!(
+        "{}/{cases} handled cleanly (OBJ and PNG bytes)",
+        cases - failures.len()
+    );
     assert!(failures.is_empty(), "{}", failures.join("\n"));
     let _ = std::fs::remove_dir_all(&dir);
 }
