@@ -306,3 +306,28 @@ fn a_solve_into_an_unwritable_output_is_refused_before_any_work() {
     assert!(!ok && err.contains("output folder"), "{err}");
     assert!(start.elapsed() < Duration::from_secs(20));
 }
+
+#[test]
+fn eval_and_export_refuse_a_solution_of_an_edited_scene() {
+    let (quick, _) = quick_and_slow("edited");
+    let out = tmpdir("edited-out");
+    let (ok, _, err) = solve(&quick, &out);
+    assert!(ok, "{err}");
+    // The same names, counts and t, but the head is moved: the shadow differs.
+    let edited = variant("edited-scene", |v| {
+        for s in v["stages"].as_array_mut().unwrap() {
+            s["max_iterations"] = 3.into();
+            s["population"] = 8.into();
+        }
+        v["occluders"][0]["position"][0] = 0.5.into();
+    });
+    let (o, e) = (out.to_str().unwrap(), edited.to_str().unwrap());
+    let (ok, _, err) = bsa(&["export", o, "--scene", e]);
+    assert!(!ok && err.contains("does not belong"), "{err}");
+    let sol = out.join("solution.json");
+    let (ok, _, err) = bsa(&["eval", e, "--solution", sol.to_str().unwrap()]);
+    assert!(!ok && err.contains("does not match"), "{err}");
+    // The scene it was made for is still accepted.
+    let (ok, _, err) = bsa(&["export", o, "--scene", quick.to_str().unwrap()]);
+    assert!(ok, "{err}");
+}
