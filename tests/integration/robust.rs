@@ -20,9 +20,12 @@ fn assert_refused(dir: &Path, field: &str) {
     );
 }
 
+/// An edit of the Mickey scene.
+type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+
 #[test]
 fn audit_magnitudes_are_refused_naming_the_field() {
-    let cases: Vec<(&str, Box<dyn Fn(&mut serde_json::Value)>, &str)> = vec![
+    let cases: Vec<(&str, Edit, &str)> = vec![
         (
             "orientation",
             Box::new(|v| {
