@@ -74,6 +74,7 @@ pub enum SceneError {
 
 type Result<T> = std::result::Result<T, SceneError>;
 
+mod bounds;
 mod launch;
 mod raw;
 mod start;

@@ -23,89 +23,16 @@ pub(super) struct Validator<'a> {
 }
 
 impl Validator<'_> {
-    fn field_err(&self, field: impl Into<String>, reason: impl Into<String>) -> SceneError {
+    pub(super) fn field_err(
+        &self,
+        field: impl Into<String>,
+        reason: impl Into<String>,
+    ) -> SceneError {
         SceneError::Field {
             path: self.file.to_path_buf(),
             field: field.into(),
             reason: reason.into(),
         }
-    }
-
-    fn finite(&self, field: &str, x: f64) -> Result<f64> {
-        if x.is_finite() {
-            Ok(x)
-        } else {
-            Err(self.field_err(field, format!("must be a finite number, got {x}")))
-        }
-    }
-
-    /// A finite number of magnitude at most `limit`: the bounds of `super::MAX_*` that
-    /// keep every product of the physics finite.
-    fn within(&self, field: &str, x: f64, limit: f64) -> Result<f64> {
-        let x = self.finite(field, x)?;
-        if x.abs() <= limit {
-            Ok(x)
-        } else {
-            Err(self.field_err(
-                field,
-                format!("must be within -{limit:e} to {limit:e}, got {x:e}"),
-            ))
-        }
-    }
-
-    /// A positive number of at most `limit`.
-    fn positive_within(&self, field: &str, x: f64, limit: f64) -> Result<f64> {
-        let x = self.positive(field, x)?;
-        self.within(field, x, limit)
-    }
-
-    fn positive(&self, field: &str, x: f64) -> Result<f64> {
-        let x = self.finite(field, x)?;
-        if x > 0.0 {
-            Ok(x)
-        } else {
-            Err(self.field_err(field, format!("must be positive, got {x}")))
-        }
-    }
-
-    fn non_negative(&self, field: &str, x: f64) -> Result<f64> {
-        let x = self.finite(field, x)?;
-        if x >= 0.0 {
-            Ok(x)
-        } else {
-            Err(self.field_err(field, format!("must not be negative, got {x}")))
-        }
-    }
-
-    /// A point or length vector: every component within [`MAX_COORDINATE`] metres.
-    fn vec3(&self, field: &str, a: [f64; 3]) -> Result<DVec3> {
-        for (i, x) in a.iter().enumerate() {
-            self.within(&format!("{field}[{i}]"), *x, MAX_COORDINATE)?;
-        }
-        Ok(DVec3::from_array(a))
-    }
-
-    /// A vector whose length is at most `limit` (speeds, gravity).
-    fn vec3_len_within(&self, field: &str, a: [f64; 3], limit: f64) -> Result<DVec3> {
-        let v = self.vec3(field, a)?;
-        let len = v.length();
-        if len <= limit {
-            Ok(v)
-        } else {
-            Err(self.field_err(
-                field,
-                format!("has magnitude {len:e}, more than the {limit:e} allowed"),
-            ))
-        }
-    }
-
-    fn unit(&self, field: &str, a: [f64; 3]) -> Result<DVec3> {
-        let v = self.vec3(field, a)?;
-        let len = v.length();
-        if len < 1e-12 {
-            return Err(self.field_err(field, "must be a non-zero vector"));
-        }
-        Ok(v / len)
     }
 
     fn resolve(&self, rel: &str) -> PathBuf {
