@@ -253,10 +253,12 @@ fn human(bytes: u64) -> String {
 }
 
 /// The bytes a solve's files are expected to take: solution, convergence table and
-/// plot, pictures (a few RGBA copies of the target), and the exports (a pose per key and
-/// body, twice: glTF and CSV), with room to spare for the temporary copies.
+/// plot, pictures (four RGBA images of the target's size, before compression), and the
+/// exports (a pose per key and body, twice: glTF and CSV), with room to spare for the
+/// temporary copies. The convergence table grows with the samples and is not foreseen;
+/// a disk that fills during the solve is handled by putting the previous solution back.
 pub fn estimated_bytes(keys: f64, bodies: usize, pixels: usize) -> u64 {
     let exports = keys * bodies as f64 * 400.0;
-    let pictures = pixels as f64 * 4.0 * 6.0;
-    (4e6 + 2.0 * (exports + pictures)) as u64
+    let pictures = pixels as f64 * 4.0 * 4.0;
+    (4e6 + 2.0 * exports + pictures) as u64
 }

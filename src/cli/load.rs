@@ -12,7 +12,9 @@ use crate::scene::{self, Scene};
 
 /// Load and validate a scene folder or file.
 pub(super) fn scene(path: &Path) -> Result<Scene> {
-    scene::load(path).with_context(|| format!("invalid scene {}", path.display()))
+    // A scene error already names the file and the field; a context line above it
+    // would push them off the first line of the message.
+    Ok(scene::load(path)?)
 }
 
 /// Load `DIR/solution.json` and its scene, and check that they belong together: the

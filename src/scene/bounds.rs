@@ -25,7 +25,12 @@ impl Validator<'_> {
         } else {
             Err(self.field_err(
                 field,
-                format!("must be within -{limit:e} to {limit:e}, got {x:e}"),
+                format!(
+                    "must be between -{} and {}, got {}",
+                    short(limit),
+                    short(limit),
+                    short(x)
+                ),
             ))
         }
     }
@@ -33,7 +38,14 @@ impl Validator<'_> {
     /// A positive number of at most `limit`.
     pub(super) fn positive_within(&self, field: &str, x: f64, limit: f64) -> Result<f64> {
         let x = self.positive(field, x)?;
-        self.within(field, x, limit)
+        if x <= limit {
+            Ok(x)
+        } else {
+            Err(self.field_err(
+                field,
+                format!("must be at most {}, got {}", short(limit), short(x)),
+            ))
+        }
     }
 
     pub(super) fn positive(&self, field: &str, x: f64) -> Result<f64> {
@@ -83,5 +95,15 @@ impl Validator<'_> {
             return Err(self.field_err(field, "must be a non-zero vector"));
         }
         Ok(v / len)
+    }
+}
+
+/// A number as people write limits: plain up to 1e5 (3600, 0.5), in exponent form above
+/// (1e6, 1e300).
+fn short(x: f64) -> String {
+    if x.abs() < 1e5 {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
     }
 }

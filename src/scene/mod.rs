@@ -49,12 +49,13 @@ pub enum SceneError {
     #[error("{path}: the target image has no dark pixel (dark = luminance below half, opaque); there is nothing to match")]
     TargetEmpty { path: PathBuf },
     /// An OBJ mesh could not be used.
-    #[error("{path}: field `{field}`: unusable mesh")]
+    /// The reason is in the message's first line (not a cause below it), so that the
+    /// file, the field and the reason are read together.
+    #[error("{path}: field `{field}`: {error}")]
     Obj {
         path: PathBuf,
         field: String,
-        #[source]
-        source: shape::ObjError,
+        error: shape::ObjError,
     },
     /// A line of a hints text file is malformed.
     #[error("{path}:{line}: {reason}")]

@@ -320,23 +320,23 @@ impl Validator<'_> {
                     max_bytes: MAX_OBJ_BYTES,
                 };
                 let mesh: TriMesh =
-                    shape::load_obj_checked(&path, scale, &limits).map_err(|source| {
+                    shape::load_obj_checked(&path, scale, &limits).map_err(|error| {
                         // A mesh that is too large or too small once scaled is the
                         // scale's fault when one was given, not the file's.
                         let scale_fault = given_scale
                             && matches!(
-                                source,
+                                error,
                                 shape::ObjError::OutOfRange { .. }
                                     | shape::ObjError::NonFiniteVertex { .. }
                             );
                         SceneError::Obj {
-                            path: path.clone(),
+                            path: self.file.to_path_buf(),
                             field: f(if scale_fault {
                                 "shape.mesh.scale"
                             } else {
                                 "shape.mesh.obj"
                             }),
-                            source,
+                            error,
                         }
                     })?;
                 Shape::Mesh(Arc::new(mesh))

@@ -165,7 +165,7 @@ impl TriMesh {
 pub enum ObjError {
     /// The file could not be opened or read (missing, a folder, no permission); the
     /// source is the operating system's reason.
-    #[error("cannot read OBJ file {path}")]
+    #[error("cannot read OBJ file {path}: {source}")]
     Io {
         path: PathBuf,
         #[source]
@@ -180,7 +180,7 @@ pub enum ObjError {
         reason: String,
     },
     /// tobj could not parse the file and no single line could be blamed.
-    #[error("cannot parse OBJ file {path}")]
+    #[error("cannot parse OBJ file {path}: {source}")]
     Load {
         path: PathBuf,
         #[source]
