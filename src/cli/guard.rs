@@ -89,6 +89,12 @@ impl OutputGuard {
             let _ = std::fs::remove_file(&partial);
             let _ = std::fs::remove_file(self.path(PARTIAL_CONVERGENCE));
         }
+        if !is_complete(&self.path(SOLUTION)) && is_complete(&self.path(PREV_SOLUTION)) {
+            // A solve killed outright (SIGKILL) left the previous complete solution
+            // aside: it is still the one to put back unless this solve completes.
+            self.moved_previous = true;
+            return Ok(());
+        }
         if resume && !partial.exists() {
             // Resuming what is in solution.json: nothing to set aside.
             return Ok(());

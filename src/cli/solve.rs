@@ -94,7 +94,11 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             out: out.display().to_string(),
         }
         .into()),
-        Err(e) => Err(e.context(saved)),
+        Err(e) => {
+            // The cause comes first in the error below; where the files are is a note.
+            eprintln!("note: {saved}");
+            Err(e)
+        }
     }
 }
 
