@@ -174,8 +174,13 @@ fn quick_and_slow(name: &str) -> (PathBuf, PathBuf) {
             s["population"] = 8.into();
         }
     });
+    // Four long stages: two presses of Ctrl-C within the first second always leave
+    // stages undone, whichever stage they land in.
     let slow = variant(&format!("{name}-slow"), |v| {
-        for s in v["stages"].as_array_mut().unwrap() {
+        let stages = v["stages"].as_array_mut().unwrap();
+        let again = stages.clone();
+        stages.extend(again);
+        for s in stages {
             s["max_iterations"] = 1_000_000.into();
             s["stagnation"] = 100_000.into();
             s["tol_fun"] = 0.0.into();
@@ -230,13 +235,13 @@ fn an_interrupted_solve_keeps_the_previous_complete_solution() {
     while !out.join("solution.prev.json").exists() && start.elapsed() < Duration::from_secs(60) {
         std::thread::sleep(Duration::from_millis(20));
     }
-    std::thread::sleep(Duration::from_millis(1500));
+    std::thread::sleep(Duration::from_millis(500));
     // SIGTERM twice, handled like two presses of Ctrl-C.
     for _ in 0..2 {
         let _ = Command::new("kill")
             .args(["-TERM", &child.id().to_string()])
             .status();
-        std::thread::sleep(Duration::from_millis(300));
+        std::thread::sleep(Duration::from_millis(100));
     }
     let result = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&result.stderr);
@@ -275,6 +280,17 @@ fn a_solve_that_cannot_write_keeps_the_previous_complete_solution_and_no_tempora
         "{:?}",
         leftover_temporaries(&out)
     );
+
+    // What a SIGKILL leaves: the previous solution aside, a stale lock, no solution.json.
+    // The next solve that fails still puts the previous one back.
+    std::fs::rename(out.join("solution.json"), out.join("solution.prev.json")).unwrap();
+    std::fs::write(out.join(".bsa-solve.lock"), "4999999\n").unwrap();
+    let (ok, _, err) = solve(&quick, &out);
+    assert!(
+        !ok && err.contains("previous complete solution is kept"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(out.join("solution.json")).unwrap(), before);
 }
 
 #[test]
