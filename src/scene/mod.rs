@@ -260,7 +260,8 @@ pub const MAX_WEIGHT: f64 = 1e12;
 /// Largest CMA-ES step size of a stage (in the optimizer's scaled units).
 pub const MAX_STEP: f64 = 1e3;
 /// Most occluders a scene may hold. The solver keeps per-pair contact data (pairs grow
-/// as the square of the count), so this keeps a scene's memory within a few hundred MB.
+/// as the square of the count); a solve of 1000 small spheres was measured at 0.8 GB
+/// (10,000 asked for 28.8 GB and aborted).
 pub const MAX_OCCLUDERS: usize = 1000;
 /// Most CMA-ES iterations of a stage, and the largest stagnation window.
 pub const MAX_ITERATIONS: usize = 1_000_000;
