@@ -350,3 +350,67 @@ fn eval_and_export_refuse_a_solution_of_an_edited_scene() {
     let (ok, _, err) = bsa(&["export", o, "--scene", quick.to_str().unwrap()]);
     assert!(ok, "{err}");
 }
+
+/// The OBJ text of a closed UV sphere of radius 1 (`m` meridians, `n` bands):
+/// `2 m (n - 1)` triangles.
+fn uv_sphere_obj(m: usize, n: usize) -> String {
+    use std::fmt::Write;
+    let mut s = String::from("v 0 0 1\n");
+    for i in 1..n {
+        let th = std::f64::consts::PI * i as f64 / n as f64;
+        for j in 0..m {
+            let ph = 2.0 * std::f64::consts::PI * j as f64 / m as f64;
+            let (x, y, z) = (th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
+            writeln!(s, "v {x:.7} {y:.7} {z:.7}").unwrap();
+        }
+    }
+    s.push_str("v 0 0 -1\n");
+    let ring = |i: usize, j: usize| 2 + i * m + j % m;
+    for j in 0..m {
+        writeln!(s, "f 1 {} {}", ring(0, j), ring(0, j + 1)).unwrap();
+    }
+    for i in 0..n - 2 {
+        for j in 0..m {
+            let (a, b, c, d) = (
+                ring(i, j),
+                ring(i, j + 1),
+                ring(i + 1, j),
+                ring(i + 1, j + 1),
+            );
+            writeln!(s, "f {a} {c} {d}\nf {a} {d} {b}").unwrap();
+        }
+    }
+    let last = (n - 1) * m + 2;
+    for j in 0..m {
+        writeln!(s, "f {} {last} {}", ring(n - 2, j), ring(n - 2, j + 1)).unwrap();
+    }
+    s
+}
+
+#[test]
+fn solve_and_export_of_75k_and_100k_triangle_spheres_do_not_panic() {
+    // parry's hull of these spheres has no faces; the continuation (after t, in solve
+    // and export) used to panic on it after solution.json was written.
+    for (m, n) in [(250, 151), (250, 201)] {
+        let d = variant(&format!("sphere-{n}"), |v| {
+            v["occluders"][0]["shape"] =
+                serde_json::json!({ "mesh": { "obj": "sphere.obj", "scale": 0.6 } });
+            for s in v["stages"].as_array_mut().unwrap() {
+                s["max_iterations"] = 2.into();
+                s["population"] = 6.into();
+            }
+        });
+        std::fs::write(d.join("sphere.obj"), uv_sphere_obj(m, n)).unwrap();
+        let out = d.join("out");
+        let (ok, _, err) = solve(&d, &out);
+        assert!(ok, "{err}");
+        let (ok, _, err) = bsa(&[
+            "export",
+            out.to_str().unwrap(),
+            "--scene",
+            d.to_str().unwrap(),
+        ]);
+        assert!(ok, "{err}");
+        assert!(out.join("mickey.glb").is_file());
+    }
+}
