@@ -9,6 +9,13 @@ fn main() {
         for cause in err.chain().skip(1) {
             eprintln!("  caused by: {cause}");
         }
-        std::process::exit(1);
+        // An interrupted solve saved its progress and said how to resume; it still did
+        // not finish, so it must not look like success (or like any other failure).
+        let interrupted = err.downcast_ref::<bsa::cli::guard::Interrupted>().is_some();
+        std::process::exit(if interrupted {
+            bsa::cli::guard::EXIT_INTERRUPTED
+        } else {
+            1
+        });
     }
 }

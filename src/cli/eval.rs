@@ -9,7 +9,6 @@ use anyhow::{bail, Context, Result};
 use crate::energy::{Term, Weights};
 use crate::evaluate::Problem;
 use crate::output::files;
-use crate::output::solution;
 use crate::scene::Scene;
 
 use super::{load, EvalArgs};
@@ -58,7 +57,9 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let problem = Problem::new(scene);
     let solution_path = &opts.solution;
     let s = files::read_solution(solution_path)?;
-    solution::check_solution(&problem.scene, &s)
+    // As budget does: the names, counts and t, and the same shadow when re-evaluated, so
+    // that a solution of an edited scene is refused instead of reported as if current.
+    crate::budget::check_solution_current(&problem, &s)
         .with_context(|| format!("{} does not match the scene", solution_path.display()))?;
     let scene = &problem.scene;
     let weights = scene.stages[k - 1].weights;

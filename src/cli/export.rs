@@ -8,6 +8,7 @@ use anyhow::{bail, Context, Result};
 use crate::evaluate::Problem;
 use crate::output::files;
 use crate::output::solution::Solution;
+use crate::scene::{MAX_KEYS, MAX_T};
 
 use super::{load, ExportArgs};
 
@@ -22,8 +23,8 @@ pub(super) struct Options {
 impl Options {
     pub(super) fn new(args: ExportArgs) -> Result<Options> {
         let after = args.after;
-        if !(after.is_finite() && after >= 0.0) {
-            bail!("--after must be a non-negative number of seconds, got {after}");
+        if !(after.is_finite() && (0.0..=MAX_T).contains(&after)) {
+            bail!("--after must be a number of seconds from 0 to {MAX_T}, got {after}");
         }
         Ok(Options {
             dir: args.dir,
@@ -48,6 +49,15 @@ pub(super) fn write_exports(
     solution: &Solution,
     after: f64,
 ) -> Result<String> {
+    // The continuation stores a pose per key and body, so its key count is bounded as
+    // the scene's is.
+    let keys = after / problem.scene.dt;
+    if keys > MAX_KEYS {
+        bail!(
+            "--after {after} s is {keys:.0} keys of {} s, more than the {MAX_KEYS:e} allowed; give a shorter --after",
+            problem.scene.dt
+        );
+    }
     let params = solution.parameters();
     let track = crate::output::trajectory::track(problem, &params, after);
     let name = &problem.scene.name;

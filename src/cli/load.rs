@@ -7,19 +7,23 @@ use anyhow::{bail, Context, Result};
 
 use crate::evaluate::Problem;
 use crate::output::files;
-use crate::output::solution::{self, Solution};
+use crate::output::solution::Solution;
 use crate::scene::{self, Scene};
 
 /// Load and validate a scene folder or file.
 pub(super) fn scene(path: &Path) -> Result<Scene> {
-    scene::load(path).with_context(|| format!("invalid scene {}", path.display()))
+    // A scene error already names the file and the field; a context line above it
+    // would push them off the first line of the message.
+    Ok(scene::load(path)?)
 }
 
-/// Load `DIR/solution.json` and its scene, and check that they belong together.
+/// Load `DIR/solution.json` and its scene, and check that they belong together: the
+/// names, counts and `t`, and the same shadow when re-evaluated (as budget checks), so
+/// that export, validate and video refuse a solution of an edited scene.
 pub(super) fn solution_dir(dir: &Path, scene: Option<&Path>) -> Result<(Problem, Solution)> {
     let file = dir.join("solution.json");
     let (problem, solution, scene_path) = solution_and_scene(dir, &file, scene)?;
-    solution::check_solution(&problem.scene, &solution).with_context(|| {
+    crate::budget::check_solution_current(&problem, &solution).with_context(|| {
         format!(
             "{} does not belong to the scene {} (pass the right one with --scene)",
             file.display(),

@@ -21,6 +21,7 @@ mod budget;
 mod check;
 mod eval;
 mod export;
+pub mod guard;
 mod load;
 mod new;
 mod plant;

@@ -2,7 +2,7 @@
 //! (solution, pictures, convergence table and plot, and the exports of `bsa export`),
 //! with progress bars, resuming and a two-step Ctrl-C.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use anyhow::{bail, Context, Result};
@@ -14,7 +14,7 @@ use crate::output::files;
 use crate::output::solution::{self, Solution};
 
 use super::progress::SolveProgress;
-use super::{export, load, SolveArgs};
+use super::{export, guard, load, SolveArgs};
 
 /// Ctrl-C presses so far. The solver reads it between iterations: one press ends the
 /// current stage, a second one stops and saves the best so far.
@@ -57,6 +57,8 @@ impl Options {
 }
 
 /// Solve the scene, saving progress as it goes, then write the pictures and exports.
+/// The output folder is locked and checked first, and a complete solution already in it
+/// survives any solve that does not complete (see [`guard`]).
 pub(super) fn run(opts: &Options) -> Result<()> {
     let mut clock = Clock::new();
     let scene = load::scene(&opts.scene)?;
@@ -65,8 +67,53 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("export").join(&scene.name));
     let problem = Problem::new(scene);
-    let scene = &problem.scene;
     clock.lap("scene loading and set-up");
+    let scene = &problem.scene;
+    let needed = guard::estimated_bytes(
+        (scene.t + crate::output::trajectory::DEFAULT_AFTER) / scene.dt,
+        scene.occluders.len(),
+        scene.target.width() * scene.target.height(),
+    );
+    let guard = guard::OutputGuard::acquire(&out, opts.resume, needed)?;
+    let result = solve_into(opts, &problem, &out, guard.has_previous(), clock);
+    let incomplete = match &result {
+        // A stage shortened by one Ctrl-C still counts as run: the user chose to end it.
+        Ok(solution) => solution.stages_completed < solution.stages_total,
+        Err(_) => true,
+    };
+    if !incomplete {
+        return Ok(());
+    }
+    let saved = guard.keep_previous();
+    match result {
+        Ok(s) => Err(guard::Interrupted {
+            done: s.stages_completed,
+            total: s.stages_total,
+            saved,
+            scene: opts.scene.display().to_string(),
+            out: out.display().to_string(),
+        }
+        .into()),
+        Err(e) => {
+            // The cause comes first in the error below; where the files are is a note.
+            eprintln!("note: {saved}");
+            Err(e)
+        }
+    }
+}
+
+/// The solve itself, into a locked output folder; returns the solution it saved.
+/// With `keep_previous`, an unfinished solve stops after saving its solution, so that the
+/// pictures and exports of the previous complete one stay.
+fn solve_into(
+    opts: &Options,
+    problem: &Problem,
+    out: &Path,
+    keep_previous: bool,
+    mut clock: Clock,
+) -> Result<Solution> {
+    let scene = &problem.scene;
+    let out = out.to_path_buf();
     let mut prior = Vec::new();
     let resume_from = if opts.resume {
         let file = out.join("solution.json");
@@ -80,7 +127,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
                 file.display(),
                 s.stages_total
             );
-            return Ok(());
+            return Ok(s);
         }
         let conv = out.join("convergence.csv");
         if conv.exists() {
@@ -94,7 +141,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     } else {
         None
     };
-    std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
+    // With ctrlc's "termination" feature this handles SIGTERM (and SIGHUP) like Ctrl-C.
     ctrlc::set_handler(|| {
         let n = INTERRUPTS.fetch_add(1, Ordering::SeqCst) + 1;
         if n == 1 {
@@ -114,7 +161,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     };
     clock.lap("resume and output folder");
     let first_stage = options.resume.as_ref().map_or(0, |s| s.stages_completed);
-    let (solution, records) = solver::solve(&problem, &options, &mut observer, &INTERRUPTS);
+    let (solution, records) = solver::solve(problem, &options, &mut observer, &INTERRUPTS);
     // The solver's time, split: its stages, and the rest (the summary and the per-phase
     // profile of one sample); then the wait for the files the stages left to write.
     let solving = clock.since_lap();
@@ -136,6 +183,9 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     all.extend(records);
     files::write_convergence_plot(&out, &observer.stage_names, &all)?;
     clock.lap("solution, convergence table and plot");
+    if keep_previous && solution.stages_completed < solution.stages_total {
+        return Ok(solution);
+    }
     let mut ws = problem.workspace();
     let params = solution.parameters();
     problem.evaluate(&params, &Weights::all_ones(), &mut ws);
@@ -144,7 +194,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     clock.lap("shadow, overlay and preview");
     let exported = export::write_exports(
         &out,
-        &problem,
+        problem,
         &solution,
         crate::output::trajectory::DEFAULT_AFTER,
     )?;
@@ -169,7 +219,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     if opts.report {
         print_report(&solution, &clock);
     }
-    Ok(())
+    Ok(solution)
 }
 
 /// Where the wall time of `bsa solve` went, phase by phase in the order they run.

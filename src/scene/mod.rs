@@ -49,12 +49,13 @@ pub enum SceneError {
     #[error("{path}: the target image has no dark pixel (dark = luminance below half, opaque); there is nothing to match")]
     TargetEmpty { path: PathBuf },
     /// An OBJ mesh could not be used.
-    #[error("{path}: field `{field}`: unusable mesh")]
+    /// The reason is in the message's first line (not a cause below it), so that the
+    /// file, the field and the reason are read together.
+    #[error("{path}: field `{field}`: {error}")]
     Obj {
         path: PathBuf,
         field: String,
-        #[source]
-        source: shape::ObjError,
+        error: shape::ObjError,
     },
     /// A line of a hints text file is malformed.
     #[error("{path}:{line}: {reason}")]
@@ -74,6 +75,7 @@ pub enum SceneError {
 
 type Result<T> = std::result::Result<T, SceneError>;
 
+mod bounds;
 mod launch;
 mod raw;
 mod start;
@@ -249,6 +251,45 @@ pub const RESERVED_NAMES: [&str; 5] =
 pub const MAX_IMAGE_SIDE: usize = 16384;
 /// Largest CMA-ES population a stage may ask for.
 pub const MAX_POPULATION: usize = 100_000;
+
+/// Largest magnitude (m) of any coordinate or length in a scene: positions, the light,
+/// the receiver, the table, hint points, shape sizes and mesh vertices after scaling.
+/// Products of these (squared distances, volumes, moments of inertia) then stay far
+/// from overflow, and no real launch needs more than a thousand kilometres.
+pub const MAX_COORDINATE: f64 = 1e6;
+/// Longest flight time `t` (s): one hour.
+pub const MAX_T: f64 = 3600.0;
+/// Most timesteps (keys) from launch to `t`, `t / timestep`; the trajectory, the
+/// animated export and the continuation store one pose per key and body.
+pub const MAX_KEYS: f64 = 1_000_000.0;
+/// Largest gravity magnitude (m/s^2), a hundred times the Earth's.
+pub const MAX_GRAVITY: f64 = 1000.0;
+/// Largest start speed (m/s) and start angular speed (rad/s) of any occluder.
+pub const MAX_SPEED: f64 = 1e4;
+/// Largest mass (kg) and density (kg/m^3) of an occluder.
+pub const MAX_MASS: f64 = 1e9;
+/// Largest hint pixel coordinate magnitude and largest weight of any term or hint.
+pub const MAX_PIXEL: f64 = 1e6;
+/// Largest weight of an energy term or a hint.
+pub const MAX_WEIGHT: f64 = 1e12;
+/// Largest CMA-ES step size of a stage (in the optimizer's scaled units).
+pub const MAX_STEP: f64 = 1e3;
+/// Most occluders a scene may hold. The solver keeps per-pair contact data (pairs grow
+/// as the square of the count); a solve of 1000 small spheres was measured at 0.8 GB
+/// (10,000 asked for 28.8 GB and aborted).
+pub const MAX_OCCLUDERS: usize = 1000;
+/// Most CMA-ES iterations of a stage, and the largest stagnation window.
+pub const MAX_ITERATIONS: usize = 1_000_000;
+/// Largest stagnation window (iterations) of a stage; the solver keeps a history this
+/// long.
+pub const MAX_STAGNATION: usize = 100_000;
+/// Most stages a scene may expand to (scheduled list, or rounds times the order).
+pub const MAX_STAGES: usize = 10_000;
+/// Most triangles of one OBJ mesh after triangulation; larger meshes are refused with a
+/// clear error (decimate them first), which keeps loading and hull building to seconds.
+pub const MAX_MESH_TRIANGLES: usize = 200_000;
+/// Largest OBJ file (bytes) read at all; larger files are refused before parsing.
+pub const MAX_OBJ_BYTES: u64 = 200 * 1024 * 1024;
 
 /// Default simulation timestep (s), as in the paper.
 pub const DEFAULT_TIMESTEP: f64 = 1.0 / 60.0;

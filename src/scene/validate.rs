@@ -23,54 +23,16 @@ pub(super) struct Validator<'a> {
 }
 
 impl Validator<'_> {
-    fn field_err(&self, field: impl Into<String>, reason: impl Into<String>) -> SceneError {
+    pub(super) fn field_err(
+        &self,
+        field: impl Into<String>,
+        reason: impl Into<String>,
+    ) -> SceneError {
         SceneError::Field {
             path: self.file.to_path_buf(),
             field: field.into(),
             reason: reason.into(),
         }
-    }
-
-    fn finite(&self, field: &str, x: f64) -> Result<f64> {
-        if x.is_finite() {
-            Ok(x)
-        } else {
-            Err(self.field_err(field, format!("must be a finite number, got {x}")))
-        }
-    }
-
-    fn positive(&self, field: &str, x: f64) -> Result<f64> {
-        let x = self.finite(field, x)?;
-        if x > 0.0 {
-            Ok(x)
-        } else {
-            Err(self.field_err(field, format!("must be positive, got {x}")))
-        }
-    }
-
-    fn non_negative(&self, field: &str, x: f64) -> Result<f64> {
-        let x = self.finite(field, x)?;
-        if x >= 0.0 {
-            Ok(x)
-        } else {
-            Err(self.field_err(field, format!("must not be negative, got {x}")))
-        }
-    }
-
-    fn vec3(&self, field: &str, a: [f64; 3]) -> Result<DVec3> {
-        for (i, x) in a.iter().enumerate() {
-            self.finite(&format!("{field}[{i}]"), *x)?;
-        }
-        Ok(DVec3::from_array(a))
-    }
-
-    fn unit(&self, field: &str, a: [f64; 3]) -> Result<DVec3> {
-        let v = self.vec3(field, a)?;
-        let len = v.length();
-        if len < 1e-12 {
-            return Err(self.field_err(field, "must be a non-zero vector"));
-        }
-        Ok(v / len)
     }
 
     fn resolve(&self, rel: &str) -> PathBuf {
@@ -87,12 +49,28 @@ impl Validator<'_> {
         if name.is_empty() || name == "." || name == ".." || name.contains(['/', '\\']) {
             return Err(self.field_err("name", "must be a non-empty name without path separators"));
         }
-        let t = self.positive("t", raw.t)?;
+        let t = self.positive_within("t", raw.t, MAX_T)?;
         let dt = self.positive("timestep", raw.timestep.unwrap_or(DEFAULT_TIMESTEP))?;
         if dt > t {
             return Err(self.field_err("timestep", format!("must not exceed t = {t} s, got {dt}")));
         }
-        let gravity = self.vec3("gravity", raw.gravity.unwrap_or(DEFAULT_GRAVITY))?;
+        // Every key from launch to t is stored (trajectory, export, continuation), so
+        // their count bounds memory.
+        if t / dt > MAX_KEYS {
+            return Err(self.field_err(
+                "timestep",
+                format!(
+                    "gives {:.0} keys up to t = {t} s, more than the {MAX_KEYS:e} allowed; use a timestep of at least {:e} s",
+                    (t / dt).ceil(),
+                    t / MAX_KEYS
+                ),
+            ));
+        }
+        let gravity = self.vec3_len_within(
+            "gravity",
+            raw.gravity.unwrap_or(DEFAULT_GRAVITY),
+            MAX_GRAVITY,
+        )?;
         let light = self.vec3("light", raw.light)?;
         let receiver = self.receiver(&raw.receiver, light)?;
         let target = self.target(&raw.target)?;
@@ -114,7 +92,11 @@ impl Validator<'_> {
                 let center = self.vec3("table.center", tb.center)?;
                 let mut half = DVec3::ZERO;
                 for i in 0..3 {
-                    half[i] = self.positive(&format!("table.size[{i}]"), tb.size[i])? / 2.0;
+                    half[i] = self.positive_within(
+                        &format!("table.size[{i}]"),
+                        tb.size[i],
+                        MAX_COORDINATE,
+                    )? / 2.0;
                 }
                 Some(Table {
                     center,
@@ -122,17 +104,27 @@ impl Validator<'_> {
                 })
             }
         };
-        let rise = self.finite(
+        let rise = self.within(
             "start.rise",
             raw.start
                 .as_ref()
                 .and_then(|s| s.rise)
                 .unwrap_or(DEFAULT_START_RISE),
+            MAX_COORDINATE,
         )?;
-        let mut occluders = Vec::with_capacity(raw.occluders.len());
         if raw.occluders.is_empty() {
             return Err(self.field_err("occluders", "needs at least one occluder"));
         }
+        if raw.occluders.len() > MAX_OCCLUDERS {
+            return Err(self.field_err(
+                "occluders",
+                format!(
+                    "holds {} occluders, more than the {MAX_OCCLUDERS} supported (the solver keeps data per pair of occluders)",
+                    raw.occluders.len()
+                ),
+            ));
+        }
+        let mut occluders = Vec::with_capacity(raw.occluders.len());
         for (i, ro) in raw.occluders.iter().enumerate() {
             let o = self.occluder(i, ro, t, gravity, rise)?;
             if RESERVED_NAMES.contains(&o.name.as_str()) {
@@ -194,6 +186,7 @@ impl Validator<'_> {
                 ))
             }
         }
+        self.check_start_guess(&occluders)?;
         let (stages, strategy) = self.stages(&raw, &occluders)?;
         let contacts = match raw.contacts.as_deref() {
             Some("constraint") => Contacts::Constraint,
@@ -205,6 +198,15 @@ impl Validator<'_> {
                 ))
             }
         };
+        if stages.len() > MAX_STAGES {
+            return Err(self.field_err(
+                "strategy",
+                format!(
+                    "expands to {} stages, more than the {MAX_STAGES} supported",
+                    stages.len()
+                ),
+            ));
+        }
         Ok(Scene {
             name,
             source: self.file.to_path_buf(),
@@ -232,8 +234,8 @@ impl Validator<'_> {
         if u.dot(v).abs() > 1e-6 {
             return Err(self.field_err("receiver.v", "must be perpendicular to receiver.u"));
         }
-        let width = self.positive("receiver.width", r.width)?;
-        let height = self.positive("receiver.height", r.height)?;
+        let width = self.positive_within("receiver.width", r.width, 2.0 * MAX_COORDINATE)?;
+        let height = self.positive_within("receiver.height", r.height, 2.0 * MAX_COORDINATE)?;
         let normal = u.cross(v).normalize();
         let h = (light - center).dot(normal);
         // The image is seen from the light's side with u to the right and v up, so the
@@ -302,23 +304,51 @@ impl Validator<'_> {
         }
         let shape = match &ro.shape {
             RawShape::Sphere { radius } => Shape::Sphere {
-                radius: self.positive(&f("shape.sphere.radius"), *radius)?,
+                radius: self.positive_within(&f("shape.sphere.radius"), *radius, MAX_COORDINATE)?,
             },
             RawShape::Box { size } => {
                 let mut half = DVec3::ZERO;
                 for k in 0..3 {
-                    half[k] = self.positive(&f(&format!("shape.box.size[{k}]")), size[k])? / 2.0;
+                    half[k] = self.positive_within(
+                        &f(&format!("shape.box.size[{k}]")),
+                        size[k],
+                        MAX_COORDINATE,
+                    )? / 2.0;
                 }
                 Shape::Cuboid { half_extents: half }
             }
             RawShape::Mesh { obj, scale } => {
-                let scale = self.positive(&f("shape.mesh.scale"), scale.unwrap_or(1.0))?;
+                let given_scale = scale.is_some();
+                let scale = self.positive_within(
+                    &f("shape.mesh.scale"),
+                    scale.unwrap_or(1.0),
+                    MAX_COORDINATE,
+                )?;
                 let path = self.resolve(obj);
+                let limits = shape::ObjLimits {
+                    max_coordinate: MAX_COORDINATE,
+                    max_triangles: MAX_MESH_TRIANGLES,
+                    max_bytes: MAX_OBJ_BYTES,
+                };
                 let mesh: TriMesh =
-                    shape::load_obj(&path, scale).map_err(|source| SceneError::Obj {
-                        path: path.clone(),
-                        field: f("shape.mesh.obj"),
-                        source,
+                    shape::load_obj_checked(&path, scale, &limits).map_err(|error| {
+                        // A mesh that is too large or too small once scaled is the
+                        // scale's fault when one was given, not the file's.
+                        let scale_fault = given_scale
+                            && matches!(
+                                error,
+                                shape::ObjError::OutOfRange { .. }
+                                    | shape::ObjError::NonFiniteVertex { .. }
+                            );
+                        SceneError::Obj {
+                            path: self.file.to_path_buf(),
+                            field: f(if scale_fault {
+                                "shape.mesh.scale"
+                            } else {
+                                "shape.mesh.obj"
+                            }),
+                            error,
+                        }
                     })?;
                 Shape::Mesh(Arc::new(mesh))
             }
@@ -327,8 +357,10 @@ impl Validator<'_> {
         let orientation = match ro.orientation {
             None => DQuat::IDENTITY,
             Some(q) => {
+                // Components are bounded so that the quaternion's length cannot
+                // overflow; only its direction matters.
                 for (k, x) in q.iter().enumerate() {
-                    self.finite(&f(&format!("orientation[{k}]")), *x)?;
+                    self.within(&f(&format!("orientation[{k}]")), *x, MAX_COORDINATE)?;
                 }
                 let q = DQuat::from_xyzw(q[0], q[1], q[2], q[3]);
                 if q.length() < 1e-9 {
@@ -342,8 +374,8 @@ impl Validator<'_> {
         };
         let volume = shape.volume();
         let density = match (ro.mass, ro.density) {
-            (Some(m), None) => self.positive(&f("mass"), m)? / volume,
-            (None, Some(d)) => self.positive(&f("density"), d)?,
+            (Some(m), None) => self.positive_within(&f("mass"), m, MAX_MASS)? / volume,
+            (None, Some(d)) => self.positive_within(&f("density"), d, MAX_MASS)?,
             (None, None) => {
                 return Err(
                     self.field_err(f("mass"), "give either `mass` (kg) or `density` (kg/m^3)")
@@ -367,11 +399,11 @@ impl Validator<'_> {
         let g_up = -gravity.z;
         let default_v = DVec3::new(0.0, 0.0, (rise + 0.5 * g_up * t * t) / t);
         let start_velocity = match ro.start_velocity {
-            Some(v) => self.vec3(&f("start_velocity"), v)?,
+            Some(v) => self.vec3_len_within(&f("start_velocity"), v, MAX_SPEED)?,
             None => default_v,
         };
         let start_angular_velocity = match ro.start_angular_velocity {
-            Some(w) => self.vec3(&f("start_angular_velocity"), w)?,
+            Some(w) => self.vec3_len_within(&f("start_angular_velocity"), w, MAX_SPEED)?,
             None => DVec3::ZERO,
         };
         let bounding_radius = shape.bounding_radius(mass.local_com);
@@ -386,6 +418,29 @@ impl Validator<'_> {
             start_angular_velocity,
             bounding_radius,
         })
+    }
+
+    /// The start guess aimed at the hints is computed from several fields (hints,
+    /// receiver, light, t); even within their bounds their combination could ask for
+    /// an absurd speed, so it is checked here, where the error can still name the scene.
+    fn check_start_guess(&self, occ: &[Occluder]) -> Result<()> {
+        for (i, o) in occ.iter().enumerate() {
+            for (what, v) in [
+                ("start_velocity", o.start_velocity),
+                ("start_angular_velocity", o.start_angular_velocity),
+            ] {
+                let len = v.length();
+                if len.is_nan() || len > MAX_SPEED {
+                    return Err(self.field_err(
+                        format!("occluders[{i}].{what}"),
+                        format!(
+                            "the start guess aimed at the hints needs a speed of {len:e}, more than the {MAX_SPEED:e} allowed; check `hints`, `receiver` and `light`, or set `start.aim` to \"up\""
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
     }
 
     fn check_overlaps(&self, occ: &[Occluder], table: Option<&Table>) -> Result<()> {
@@ -439,9 +494,10 @@ impl Validator<'_> {
                 )
             })?;
         let point = self.vec3(&format!("{field}.point"), h.point)?;
-        let px = self.finite(&format!("{field}.pixel[0]"), h.pixel[0])?;
-        let py = self.finite(&format!("{field}.pixel[1]"), h.pixel[1])?;
+        let px = self.within(&format!("{field}.pixel[0]"), h.pixel[0], MAX_PIXEL)?;
+        let py = self.within(&format!("{field}.pixel[1]"), h.pixel[1], MAX_PIXEL)?;
         let weight = self.non_negative(&format!("{field}.weight"), h.weight.unwrap_or(1.0))?;
+        self.within(&format!("{field}.weight"), weight, MAX_WEIGHT)?;
         Ok(Hint {
             occluder,
             point,
@@ -523,6 +579,7 @@ impl Validator<'_> {
                 )
             })?;
             w[term as usize] = self.non_negative(&format!("{field}.weights.{key}"), *value)?;
+            self.within(&format!("{field}.weights.{key}"), *value, MAX_WEIGHT)?;
         }
         let vary = match &rs.vary {
             None => default_vary.to_vec(),
@@ -564,10 +621,14 @@ impl Validator<'_> {
             return Err(self.field_err(format!("{field}.vary"), "no occluder varies in this stage"));
         }
         let n = Launch::LEN * vary.len();
-        let step = self.positive(&format!("{field}.step"), rs.step.unwrap_or(0.3))?;
+        let step =
+            self.positive_within(&format!("{field}.step"), rs.step.unwrap_or(0.3), MAX_STEP)?;
         let max_iterations = rs.max_iterations.unwrap_or(150);
-        if max_iterations == 0 {
-            return Err(self.field_err(format!("{field}.max_iterations"), "must be at least 1"));
+        if !(1..=MAX_ITERATIONS).contains(&max_iterations) {
+            return Err(self.field_err(
+                format!("{field}.max_iterations"),
+                format!("must be between 1 and {MAX_ITERATIONS}, got {max_iterations}"),
+            ));
         }
         let population = rs
             .population
@@ -584,10 +645,10 @@ impl Validator<'_> {
         };
         let tol_fun = self.non_negative(&format!("{field}.tol_fun"), rs.tol_fun.unwrap_or(1e-9))?;
         let stagnation = rs.stagnation.unwrap_or(60);
-        if stagnation == 0 {
+        if !(1..=MAX_STAGNATION).contains(&stagnation) {
             return Err(self.field_err(
                 format!("{field}.stagnation"),
-                "must be at least 1 iteration",
+                format!("must be between 1 and {MAX_STAGNATION} iterations, got {stagnation}"),
             ));
         }
         Ok(Stage {

@@ -18,8 +18,9 @@
 //!   properties are passed explicitly (principal inertia and frame from [`crate::geometry::shape`])
 //!   and colliders get zero density.
 
-use glam::{DQuat, DVec3};
+use glam::{DQuat, DVec3, Vec3};
 use rapier3d::parry::math::Pose;
+use rapier3d::parry::shape::ConvexPolyhedron;
 use rapier3d::prelude::{
     ColliderBuilder, MassProperties, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle, SharedShape,
 };
@@ -130,8 +131,7 @@ pub fn simulate(
             }
             Shape::Mesh(m) => {
                 let pts: Vec<_> = m.vertices.iter().map(|v| v.as_vec3()).collect();
-                ColliderBuilder::convex_hull(&pts)
-                    .unwrap_or_else(|| ColliderBuilder::ball(o.bounding_radius as f32))
+                ColliderBuilder::new(mesh_hull(&pts, o.bounding_radius))
             }
         }
         .density(0.0)
@@ -163,9 +163,96 @@ pub fn simulate(
     frames
 }
 
+/// Directions of the support points that the fallback hull is built from: a Fibonacci
+/// sphere, evenly spread, so that the points it picks are well apart.
+const FALLBACK_DIRECTIONS: usize = 512;
+
+/// The collider of a mesh: its convex hull, or, where parry's hull of the full point set
+/// is unusable, a hull it can use. On finely tessellated curved meshes (spheres of 75k
+/// triangles and more) parry's f32 hull can come back with no faces, or with vertices
+/// that no face touches, and its contact queries then index an empty list and panic.
+/// The fallback is the hull of the mesh's support points in [`FALLBACK_DIRECTIONS`]
+/// directions (inscribed in the true hull, within a small fraction of its size for such
+/// meshes), and, should that fail too, the bounding ball.
+pub(crate) fn mesh_hull(pts: &[Vec3], bounding_radius: f64) -> SharedShape {
+    if let Some(hull) = usable_hull(pts) {
+        return hull;
+    }
+    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    let n = FALLBACK_DIRECTIONS;
+    let mut picked: Vec<Vec3> = (0..n)
+        .filter_map(|k| {
+            let z = 1.0 - 2.0 * (k as f32 + 0.5) / n as f32;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let phi = golden * k as f32;
+            let d = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+            pts.iter()
+                .copied()
+                .max_by(|a, b| a.dot(d).total_cmp(&b.dot(d)))
+        })
+        .collect();
+    picked.sort_by(|a, b| {
+        a.to_array()
+            .partial_cmp(&b.to_array())
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    picked.dedup();
+    usable_hull(&picked).unwrap_or_else(|| SharedShape::ball(bounding_radius as f32))
+}
+
+/// parry's convex hull of `pts` if every query on it is safe: at least one face, and
+/// every vertex on a face.
+fn usable_hull(pts: &[Vec3]) -> Option<SharedShape> {
+    let hull = ConvexPolyhedron::from_convex_hull(pts)?;
+    let ok = !hull.faces().is_empty()
+        && !hull.points().is_empty()
+        && hull.vertices().iter().all(|v| v.num_adj_faces_or_edge > 0)
+        && hull.points().iter().all(|p| p.is_finite());
+    ok.then(|| SharedShape::new(hull))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The vertices of the UV sphere of the audit (`m` meridians, `n` bands): 250 x 151
+    /// gives 75,000 triangles, 250 x 201 gives 100,000.
+    fn uv_sphere(m: usize, n: usize) -> Vec<Vec3> {
+        let mut v = vec![Vec3::Z, -Vec3::Z];
+        for i in 1..n {
+            let th = std::f64::consts::PI * i as f64 / n as f64;
+            for j in 0..m {
+                let ph = 2.0 * std::f64::consts::PI * j as f64 / m as f64;
+                v.push(DVec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()).as_vec3());
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn mesh_hulls_of_finely_tessellated_spheres_are_usable() {
+        for (m, n) in [(250, 151), (250, 201)] {
+            let pts = uv_sphere(m, n);
+            // parry's own hull of these points is the unusable one the fallback exists for.
+            assert!(
+                usable_hull(&pts).is_none(),
+                "{m} x {n}: parry's hull is usable now"
+            );
+            let shape = mesh_hull(&pts, 1.0);
+            let hull = shape
+                .as_convex_polyhedron()
+                .expect("a polyhedron, not the bounding ball");
+            assert!(!hull.faces().is_empty());
+            assert!(hull.vertices().iter().all(|v| v.num_adj_faces_or_edge > 0));
+            // Inscribed in the unit sphere and close to it.
+            let r = hull
+                .points()
+                .iter()
+                .map(|p| p.length())
+                .fold(0.0f32, f32::max);
+            assert!(r > 0.99 && r <= 1.0 + 1e-6, "{r}");
+        }
+    }
     use crate::scene::Launch;
     use crate::sim::flight::{FlightConfig, FreeFlight, LaunchState};
 

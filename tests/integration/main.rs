@@ -4,7 +4,11 @@
 //! - `scene_errors`: bad scenes get clear errors that name the file and the field;
 //! - `solver`: determinism, resume, interrupts, strategies, the golden shadow, Mickey;
 //! - `exports`: the glTF poses and tables, the Khronos validator, the error budget;
-//! - `blender`: the Cycles mask, the Blender import and the video.
+//! - `blender`: the Cycles mask, the Blender import and the video;
+//! - `robust`: the audit of issue #13 (bad magnitudes, meshes, interrupted and failing
+//!   solves, the lock);
+//! - `fuzz`: scene mutations generated from the schema, run through `check` and a short
+//!   solve under a timeout.
 //!
 //! The tests that need an outside tool (Node's Khronos glTF validator, Blender's bpy) are
 //! `#[ignore]`d with the reason, so `cargo test` lists them as ignored; when run
@@ -14,7 +18,9 @@
 mod blender;
 mod cli;
 mod exports;
+mod fuzz;
 mod render;
+mod robust;
 mod scene_errors;
 mod solver;
 mod util;

@@ -105,6 +105,32 @@ impl TriMesh {
             .all(|&e| edges.binary_search(&e.rotate_right(32)).is_ok())
     }
 
+    /// Number of undirected edges that belong to exactly one triangle: zero for a
+    /// closed mesh, the length of the holes' rims otherwise.
+    pub fn boundary_edge_count(&self) -> usize {
+        let mut edges: Vec<u64> = Vec::with_capacity(3 * self.triangles.len());
+        for t in &self.triangles {
+            for i in 0..3 {
+                let (a, b) = (t[i] as u64, t[(i + 1) % 3] as u64);
+                edges.push((a.min(b) << 32) | a.max(b));
+            }
+        }
+        edges.sort_unstable();
+        let mut count = 0;
+        let mut i = 0;
+        while i < edges.len() {
+            let mut j = i + 1;
+            while j < edges.len() && edges[j] == edges[i] {
+                j += 1;
+            }
+            if j - i == 1 {
+                count += 1;
+            }
+            i = j;
+        }
+        count
+    }
+
     /// Reverses the orientation of every triangle (normals point the other way).
     pub fn flip(&mut self) {
         for t in &mut self.triangles {
@@ -137,12 +163,57 @@ impl TriMesh {
 /// Why [`load_obj`] rejected a file.
 #[derive(Debug, thiserror::Error)]
 pub enum ObjError {
-    /// The file could not be opened or read, or tobj could not parse it.
-    #[error("cannot read or parse OBJ file {path}")]
+    /// The file could not be opened or read (missing, a folder, no permission); the
+    /// source is the operating system's reason.
+    #[error("cannot read OBJ file {path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A line of the file is not valid OBJ (a number that does not parse, a face index
+    /// out of range).
+    #[error("{path}:{line}: {reason}")]
+    Syntax {
+        path: PathBuf,
+        line: usize,
+        reason: String,
+    },
+    /// tobj could not parse the file and no single line could be blamed.
+    #[error("cannot parse OBJ file {path}: {source}")]
     Load {
         path: PathBuf,
         #[source]
         source: tobj::LoadError,
+    },
+    /// The file is larger than [`ObjLimits::max_bytes`].
+    #[error("OBJ file {path} is {bytes} bytes, more than the {max} supported")]
+    TooBig { path: PathBuf, bytes: u64, max: u64 },
+    /// The mesh has more triangles than [`ObjLimits::max_triangles`].
+    #[error(
+        "OBJ file {path} has {triangles} triangles, more than the {max} supported; decimate it"
+    )]
+    TooManyTriangles {
+        path: PathBuf,
+        triangles: usize,
+        max: usize,
+    },
+    /// A vertex lies farther than [`ObjLimits::max_coordinate`] from the origin along
+    /// an axis once scaled.
+    #[error("OBJ file {path}: vertex {index} is {vertex} after scaling by {scale}, outside the +-{max:e} m supported")]
+    OutOfRange {
+        path: PathBuf,
+        index: usize,
+        vertex: DVec3,
+        scale: f64,
+        max: f64,
+    },
+    /// The mesh is not closed: some edges belong to a single triangle, so it has no
+    /// well-defined inside (volume, mass, shadow fill).
+    #[error("OBJ file {path} is not a closed mesh: {boundary_edges} edges belong to a single triangle (a hole); close it")]
+    Open {
+        path: PathBuf,
+        boundary_edges: usize,
     },
     /// The file parsed but holds no triangle with three distinct vertices (no `f` lines,
     /// or only points, lines and collapsed faces).
@@ -178,6 +249,131 @@ pub fn box_corners(he: DVec3) -> [DVec3; 8] {
             if i & 4 != 0 { he.z } else { -he.z },
         )
     })
+}
+
+/// What [`load_obj_checked`] accepts: bounds that keep loading time, memory and the
+/// mesh's arithmetic within what the machine can serve.
+#[derive(Clone, Debug)]
+pub struct ObjLimits {
+    /// Largest magnitude of a vertex coordinate after scaling (m).
+    pub max_coordinate: f64,
+    /// Most triangles after triangulation and welding.
+    pub max_triangles: usize,
+    /// Largest file size (bytes).
+    pub max_bytes: u64,
+}
+
+/// [`load_obj`] for scene input: the file's size is checked before it is read, the
+/// OS reason is kept when it cannot be read, a line number is given when it does not
+/// parse, and the mesh must be closed, within the triangle count and within the
+/// coordinate range.
+pub fn load_obj_checked(path: &Path, scale: f64, limits: &ObjLimits) -> Result<TriMesh, ObjError> {
+    let io = |source| ObjError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if meta.is_dir() {
+        return Err(io(std::io::Error::other("it is a folder, not a file")));
+    }
+    if meta.len() > limits.max_bytes {
+        return Err(ObjError::TooBig {
+            path: path.to_path_buf(),
+            bytes: meta.len(),
+            max: limits.max_bytes,
+        });
+    }
+    // Opening the file here gives the OS reason (permission denied, ...) that tobj
+    // would drop.
+    std::fs::File::open(path).map_err(io)?;
+    let mesh = load_obj(path, scale).map_err(|e| match e {
+        ObjError::Load { path, source } => match first_bad_line(&path) {
+            Some((line, reason)) => ObjError::Syntax { path, line, reason },
+            None => ObjError::Load { path, source },
+        },
+        other => other,
+    })?;
+    if mesh.triangles.len() > limits.max_triangles {
+        return Err(ObjError::TooManyTriangles {
+            path: path.to_path_buf(),
+            triangles: mesh.triangles.len(),
+            max: limits.max_triangles,
+        });
+    }
+    if let Some((index, &vertex)) = mesh
+        .vertices
+        .iter()
+        .enumerate()
+        .find(|(_, v)| v.abs().max_element() > limits.max_coordinate)
+    {
+        return Err(ObjError::OutOfRange {
+            path: path.to_path_buf(),
+            index,
+            vertex,
+            scale,
+            max: limits.max_coordinate,
+        });
+    }
+    let boundary_edges = mesh.boundary_edge_count();
+    if boundary_edges > 0 {
+        return Err(ObjError::Open {
+            path: path.to_path_buf(),
+            boundary_edges,
+        });
+    }
+    Ok(mesh)
+}
+
+/// The first line of an OBJ file that tobj would refuse, with the reason, found by a
+/// linear scan of `v` and `f` lines (only run after tobj failed, to name the line).
+fn first_bad_line(path: &Path) -> Option<(usize, String)> {
+    let text = std::fs::read(path).ok()?;
+    let text = String::from_utf8_lossy(&text);
+    let mut vertices: i64 = 0;
+    for (k, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let nums: Vec<&str> = words.collect();
+                if nums.len() < 3 {
+                    return Some((
+                        k + 1,
+                        format!("a vertex needs 3 coordinates, got {}", nums.len()),
+                    ));
+                }
+                if let Some(bad) = nums.iter().find(|w| w.parse::<f32>().is_err()) {
+                    return Some((k + 1, format!("vertex coordinate `{bad}` is not a number")));
+                }
+                vertices += 1;
+            }
+            Some("f") => {
+                let corners: Vec<&str> = words.collect();
+                if corners.len() < 3 {
+                    return Some((
+                        k + 1,
+                        format!("a face needs at least 3 corners, got {}", corners.len()),
+                    ));
+                }
+                for c in corners {
+                    let idx = c.split('/').next().unwrap_or("");
+                    match idx.parse::<i64>() {
+                        Err(_) => {
+                            return Some((k + 1, format!("face corner `{c}` is not a vertex index")))
+                        }
+                        Ok(i) if i == 0 || i > vertices || -i > vertices => {
+                            return Some((
+                                k + 1,
+                                format!("face corner `{c}` refers to a vertex that does not exist ({vertices} so far)"),
+                            ))
+                        }
+                        Ok(_) => {}
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    None
 }
 
 /// Loads every model of an OBJ file into one [`TriMesh`], multiplying coordinates by

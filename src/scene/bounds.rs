@@ -1,0 +1,109 @@
+//! The number checks of scene validation: every number finite, and bounded by the
+//! limits of `super` (`MAX_COORDINATE`, `MAX_SPEED`, ...) so that the products the
+//! physics forms cannot overflow and everything downstream may trust the scene.
+
+use glam::DVec3;
+
+use super::validate::Validator;
+use super::{Result, MAX_COORDINATE};
+
+impl Validator<'_> {
+    pub(super) fn finite(&self, field: &str, x: f64) -> Result<f64> {
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(self.field_err(field, format!("must be a finite number, got {x}")))
+        }
+    }
+
+    /// A finite number of magnitude at most `limit`: the bounds of `super::MAX_*` that
+    /// keep every product of the physics finite.
+    pub(super) fn within(&self, field: &str, x: f64, limit: f64) -> Result<f64> {
+        let x = self.finite(field, x)?;
+        if x.abs() <= limit {
+            Ok(x)
+        } else {
+            Err(self.field_err(
+                field,
+                format!(
+                    "must be between -{} and {}, got {}",
+                    short(limit),
+                    short(limit),
+                    short(x)
+                ),
+            ))
+        }
+    }
+
+    /// A positive number of at most `limit`.
+    pub(super) fn positive_within(&self, field: &str, x: f64, limit: f64) -> Result<f64> {
+        let x = self.positive(field, x)?;
+        if x <= limit {
+            Ok(x)
+        } else {
+            Err(self.field_err(
+                field,
+                format!("must be at most {}, got {}", short(limit), short(x)),
+            ))
+        }
+    }
+
+    pub(super) fn positive(&self, field: &str, x: f64) -> Result<f64> {
+        let x = self.finite(field, x)?;
+        if x > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.field_err(field, format!("must be positive, got {x}")))
+        }
+    }
+
+    pub(super) fn non_negative(&self, field: &str, x: f64) -> Result<f64> {
+        let x = self.finite(field, x)?;
+        if x >= 0.0 {
+            Ok(x)
+        } else {
+            Err(self.field_err(field, format!("must not be negative, got {x}")))
+        }
+    }
+
+    /// A point or length vector: every component within [`MAX_COORDINATE`] metres.
+    pub(super) fn vec3(&self, field: &str, a: [f64; 3]) -> Result<DVec3> {
+        for (i, x) in a.iter().enumerate() {
+            self.within(&format!("{field}[{i}]"), *x, MAX_COORDINATE)?;
+        }
+        Ok(DVec3::from_array(a))
+    }
+
+    /// A vector whose length is at most `limit` (speeds, gravity).
+    pub(super) fn vec3_len_within(&self, field: &str, a: [f64; 3], limit: f64) -> Result<DVec3> {
+        let v = self.vec3(field, a)?;
+        let len = v.length();
+        if len <= limit {
+            Ok(v)
+        } else {
+            Err(self.field_err(
+                field,
+                format!("has magnitude {len:e}, more than the {limit:e} allowed"),
+            ))
+        }
+    }
+
+    pub(super) fn unit(&self, field: &str, a: [f64; 3]) -> Result<DVec3> {
+        let v = self.vec3(field, a)?;
+        let len = v.length();
+        if len < 1e-12 {
+            return Err(self.field_err(field, "must be a non-zero vector"));
+        }
+        Ok(v / len)
+    }
+}
+
+/// A number as people write limits: plain up to 1e5 (3600, 0.5), in exponent form above
+/// (1e6, 1e300).
+fn short(x: f64) -> String {
+    if x.abs() < 1e5 {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
