@@ -121,15 +121,17 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         })
     ));
     files::write_atomic(&dir.join("budget.md"), md.as_bytes())?;
-    files::save_png(&plots::histogram(r), &dir.join("budget_hist.png"))?;
-    let tolerances_png = dir.join("budget_tolerances.png");
+    files::save_figure(&dir, "budget_hist", &plots::histogram(r)?)?;
     match plots::tolerances(r) {
-        Some(img) => files::save_png(&img, &tolerances_png)?,
+        Some(figure) => files::save_figure(&dir, "budget_tolerances", &figure?)?,
         // No search this time: a plot left by an earlier run would not match budget.json.
         None => {
-            if tolerances_png.is_file() {
-                std::fs::remove_file(&tolerances_png)
-                    .with_context(|| format!("removing the stale {}", tolerances_png.display()))?;
+            for ext in ["png", "svg"] {
+                let stale = dir.join(format!("budget_tolerances.{ext}"));
+                if stale.is_file() {
+                    std::fs::remove_file(&stale)
+                        .with_context(|| format!("removing the stale {}", stale.display()))?;
+                }
             }
         }
     }

@@ -134,12 +134,13 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     files::write_solution(&out, &solution)?;
     let mut all = prior;
     all.extend(records);
-    files::write_convergence_plot(&out, &observer.stage_names, &all)?;
+    files::write_convergence_plot(&out, &scene.name, &observer.stage_names, &all)?;
     clock.lap("solution, convergence table and plot");
     let mut ws = problem.workspace();
     let params = solution.parameters();
     problem.evaluate(&params, &Weights::all_ones(), &mut ws);
-    files::write_pictures(&out, &scene.target, &ws.mask)?;
+    let title = format!("{}: shadow at t = {} s", scene.name, scene.t);
+    files::write_pictures(&out, &scene.target, &ws.mask, &title)?;
     files::write_preview(&out, &scene.target, &ws.mask)?;
     clock.lap("shadow, overlay and preview");
     let exported = export::write_exports(

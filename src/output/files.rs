@@ -36,6 +36,12 @@ pub enum ExportError {
     BadConvergence { path: PathBuf, message: String },
     #[error("cannot encode {path}: {message}")]
     Encode { path: PathBuf, message: String },
+    #[error("cannot draw {path}")]
+    Picture {
+        path: PathBuf,
+        #[source]
+        source: picture::PictureError,
+    },
 }
 
 type Result<T> = std::result::Result<T, ExportError>;
@@ -109,26 +115,51 @@ pub fn read_solution(path: &Path) -> Result<Solution> {
     })
 }
 
-/// The overlay of a shadow on the target (target black, shadow translucent red).
-pub fn overlay(target: &Mask, shadow: &Mask) -> image::RgbImage {
-    picture::overlay_image(
+/// The overlay of a shadow on the target at 1:1 (agreement grey, missed target blue,
+/// extra shadow red) with `title`, the IoU and a legend below it.
+pub fn overlay(
+    target: &Mask,
+    shadow: &Mask,
+    title: &str,
+) -> std::result::Result<image::RgbImage, picture::PictureError> {
+    picture::overlay_figure(
         target.width(),
         target.height(),
         &|x, y| target.get(x, y),
         &|x, y| shadow.get(x, y),
+        title,
     )
 }
 
-/// `shadow.png` (the mask at t) and `overlay.png`.
-pub fn write_pictures(dir: &Path, target: &Mask, shadow: &Mask) -> Result<()> {
+fn save_overlay(path: &Path, target: &Mask, shadow: &Mask, title: &str) -> Result<()> {
+    let img = overlay(target, shadow, title).map_err(|source| ExportError::Picture {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    save_png(&img, path)
+}
+
+/// `shadow.png` (the mask at t) and `overlay.png` (captioned with `title`).
+pub fn write_pictures(dir: &Path, target: &Mask, shadow: &Mask, title: &str) -> Result<()> {
     let img = picture::mask_image(shadow.width(), shadow.height(), &|x, y| shadow.get(x, y));
     save_png(&img, &dir.join("shadow.png"))?;
-    save_png(&overlay(target, shadow), &dir.join("overlay.png"))
+    save_overlay(&dir.join("overlay.png"), target, shadow, title)
 }
 
 /// `preview.png`: the overlay of the best shadow so far.
 pub fn write_preview(dir: &Path, target: &Mask, shadow: &Mask) -> Result<()> {
-    save_png(&overlay(target, shadow), &dir.join("preview.png"))
+    save_overlay(
+        &dir.join("preview.png"),
+        target,
+        shadow,
+        "preview: best shadow so far",
+    )
+}
+
+/// Save a plot as `<stem>.png` and `<stem>.svg` in `dir`.
+pub fn save_figure(dir: &Path, stem: &str, figure: &picture::plot::Figure) -> Result<()> {
+    save_png(&figure.png, &dir.join(format!("{stem}.png")))?;
+    write_atomic(&dir.join(format!("{stem}.svg")), figure.svg.as_bytes())
 }
 
 /// `convergence.csv` (every sample: stage, iteration, each weighted term, total), grown
@@ -202,18 +233,21 @@ fn encode_rows(
     Ok(bytes)
 }
 
-/// `convergence.png`: one log-scale panel per stage.
+/// `convergence.png` and `convergence.svg`: every term and the total against the sample
+/// index, stage by stage (see [`picture::plot::convergence`]).
 pub fn write_convergence_plot(
     dir: &Path,
+    scene: &str,
     stage_names: &[String],
     records: &[SampleRecord],
 ) -> Result<()> {
-    let data = picture::ConvergenceData {
+    let data = picture::plot::ConvergenceData {
+        scene: scene.to_string(),
         stage_names: stage_names.to_vec(),
-        term_names: Term::ALL.iter().map(|t| t.label().to_string()).collect(),
+        term_names: Term::ALL.iter().map(|t| t.display_name()).collect(),
         rows: records
             .iter()
-            .map(|r| picture::ConvergenceRow {
+            .map(|r| picture::plot::ConvergenceRow {
                 stage: r.stage,
                 iteration: r.iteration,
                 terms: r.terms.to_vec(),
@@ -221,8 +255,11 @@ pub fn write_convergence_plot(
             })
             .collect(),
     };
-    let img = picture::convergence_plot(&data, 520, 380);
-    save_png(&img, &dir.join("convergence.png"))
+    let figure = picture::plot::convergence(&data).map_err(|source| ExportError::Picture {
+        path: dir.join("convergence.png"),
+        source,
+    })?;
+    save_figure(dir, "convergence", &figure)
 }
 
 /// Write rows as a CSV file (header from the field names), atomically.
