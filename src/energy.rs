@@ -98,7 +98,11 @@ impl Term {
     /// "d0 (0th moment)", so that the plots, tables and terminal read the same name the
     /// files use.
     pub fn display_name(self) -> String {
-        format!("{} ({})", self.key(), self.label())
+        if self.label().eq_ignore_ascii_case(self.key()) {
+            self.key().to_string()
+        } else {
+            format!("{} ({})", self.key(), self.label())
+        }
     }
 
     /// Parse a scene-file key; a few long aliases are accepted too.

@@ -182,14 +182,17 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             se.joint_scale
         );
     }
+    // The solve's report page shows the budget too, so it is rewritten with it.
+    let report = crate::output::report::write_report(&dir, &solution)?;
     println!(
-        "wrote {}/{{budget.md, budget.json, launch_drag.csv, budget_hist.png{}}} in {elapsed:.2} s",
+        "wrote {}/{{budget.md, budget.json, launch_drag.csv, budget_hist.png, budget_hist.svg{}, report.html}} in {elapsed:.2} s",
         dir.display(),
         if r.search.is_some() {
-            ", budget_tolerances.png"
+            ", budget_tolerances.png, budget_tolerances.svg"
         } else {
             ""
         }
     );
+    println!("report: {}", report.display());
     Ok(())
 }

@@ -150,6 +150,8 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         crate::output::trajectory::DEFAULT_AFTER,
     )?;
     clock.lap("exports (motion after t, glb, CSV)");
+    let report = crate::output::report::write_report(&out, &solution)?;
+    clock.lap("report page");
     println!(
         "{}: IoU at t {:.4}, {} before t ({} contacts), {} samples in {} iterations, {:.2} s on {} threads{}",
         scene.name,
@@ -166,7 +168,12 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         solution.threads,
         if solution.complete { "" } else { " (stopped early)" }
     );
+    println!(
+        "wrote {}/{{solution.json, convergence.csv, convergence.png, convergence.svg, shadow.png, overlay.png, preview.png}}",
+        out.display()
+    );
     println!("{exported}");
+    println!("report: {}", report.display());
     if opts.report {
         print_report(&solution, &clock);
     }

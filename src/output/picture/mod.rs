@@ -171,7 +171,7 @@ pub fn overlay_figure(
             let text = TextStyle::from(("sans-serif", 17).into_font()).color(&BLACK_TEXT);
             caption
                 .draw_text(
-                    &format!("{title}   IoU {:.3}", counts.iou()),
+                    &format!("{title}   IoU {:.4}", counts.iou()),
                     &text,
                     (10, 10),
                 )

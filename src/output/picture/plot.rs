@@ -261,7 +261,7 @@ fn term_pen(t: usize) -> Pen {
 
 const TOTAL_PEN: Pen = Pen {
     color: RGBColor(0, 0, 0),
-    width: 3,
+    width: 5,
     dashed: false,
 };
 const BEST_PEN: Pen = Pen {
@@ -338,6 +338,11 @@ impl Draw for ConvergencePlot<'_> {
         }
 
         let bests = generation_bests(&data.rows);
+        // The total first and wide, so that a term equal to it (XOR late in a solve)
+        // stays visible as a coloured line inside the black one.
+        for run in runs(&bests, |r| r.total) {
+            draw_line(&mut chart, run, TOTAL_PEN)?;
+        }
         let n_terms = data.rows.iter().map(|r| r.terms.len()).max().unwrap_or(0);
         let mut legend = Vec::new();
         for t in 0..n_terms {
@@ -355,9 +360,6 @@ impl Draw for ConvergencePlot<'_> {
                 .cloned()
                 .unwrap_or_else(|| format!("term {t}"));
             legend.push((pen, name));
-        }
-        for run in runs(&bests, |r| r.total) {
-            draw_line(&mut chart, run, TOTAL_PEN)?;
         }
         legend.push((TOTAL_PEN, "total (best of generation)".to_string()));
         // Best so far within each stage: the running minimum of every sample's total.
