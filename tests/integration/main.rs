@@ -4,9 +4,10 @@
 //! - `scene_errors`: bad scenes get clear errors that name the file and the field;
 //! - `solver`: determinism, resume, interrupts, strategies, the golden shadow, Mickey;
 //! - `exports`: the glTF poses and tables, the Khronos validator, the error budget;
-//! - `blender`: the Cycles mask, the Blender import and the video.
+//! - `blender`: the Cycles mask, the Blender import and the video;
+//! - `report`: `report.html` rendered by headless Chromium.
 //!
-//! The tests that need an outside tool (Node's Khronos glTF validator, Blender's bpy) are
+//! The tests that need an outside tool (Node's Khronos glTF validator, Blender's bpy, Chromium) are
 //! `#[ignore]`d with the reason, so `cargo test` lists them as ignored; when run
 //! (`cargo test -- --include-ignored`, as `scripts/test.sh` does after installing both)
 //! they run for real and a missing tool fails them.
@@ -14,6 +15,7 @@
 mod blender;
 mod cli;
 mod exports;
+mod report;
 mod scene_errors;
 mod solver;
 mod util;
