@@ -59,7 +59,10 @@ pub fn tolerances(r: &BudgetReport) -> Option<Result<Figure, PictureError>> {
         })
         .collect();
     Some(plot::tolerance_grid(&GridData {
-        title: format!("{}: IoU against the size of each launch error alone", r.scene),
+        title: format!(
+            "{}: IoU against the size of each launch error alone",
+            r.scene
+        ),
         panels,
         y_label: "IoU / probability".to_string(),
         marker_name: format!("largest tolerance (P(IoU >= {threshold}) >= 95 %)"),

@@ -33,6 +33,10 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let s = load::scene(&opts.scene)?;
     println!("scene `{}` ({})", s.name, s.source.display());
     println!(
+        "  results  {}/ (where `bsa solve` writes without --out)",
+        super::outdir::default_out(&s).display()
+    );
+    println!(
         "  target   {} x {} px, {} shadow pixels ({:.1}%)",
         s.target.width(),
         s.target.height(),

@@ -21,6 +21,7 @@ mod check;
 mod eval;
 mod export;
 mod load;
+mod outdir;
 mod progress;
 mod solve;
 mod validate;
@@ -49,7 +50,8 @@ enum Command {
     /// Validate a scene and print a summary.
     Check(CheckArgs),
     /// Optimise launch velocities and write solution.json, shadow.png, overlay.png,
-    /// convergence.csv and convergence.png.
+    /// preview.png, convergence.{csv,png,svg}, report.html, <scene>.glb, launch.csv and
+    /// trajectory.csv.
     Solve(SolveArgs),
     /// Write the animated glTF (<scene>.glb), launch.csv and trajectory.csv of a saved solution.
     Export(ExportArgs),
@@ -77,9 +79,12 @@ struct CheckArgs {
 struct SolveArgs {
     /// Scene folder (holding scene.json) or scene file.
     scene: PathBuf,
-    /// Output folder [default: export/<scene name>].
+    /// Output folder [default: export/<name of the scene's folder>].
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Replace the results of another scene (or another t) found in the output folder.
+    #[arg(long)]
+    force: bool,
     /// Random seed (overrides the scene's).
     #[arg(long)]
     seed: Option<u64>,

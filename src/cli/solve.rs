@@ -14,7 +14,7 @@ use crate::output::files;
 use crate::output::solution::{self, Solution};
 
 use super::progress::SolveProgress;
-use super::{export, load, SolveArgs};
+use super::{export, load, outdir, SolveArgs};
 
 /// Ctrl-C presses so far. The solver reads it between iterations: one press ends the
 /// current stage, a second one stops and saves the best so far.
@@ -26,12 +26,14 @@ const MAX_THREADS: usize = 1024;
 /// The validated options of `bsa solve`.
 pub(super) struct Options {
     scene: PathBuf,
-    /// `None`: `export/<scene name>`, known once the scene is loaded.
+    /// `None`: `export/<scene folder's name>`, known once the scene is loaded.
     out: Option<PathBuf>,
     seed: Option<u64>,
     /// Between 1 and [`MAX_THREADS`] when given.
     threads: Option<usize>,
     resume: bool,
+    /// Replace another scene's results in the output folder.
+    force: bool,
     report: bool,
     quiet: bool,
 }
@@ -50,6 +52,7 @@ impl Options {
             seed: args.seed,
             threads: args.threads,
             resume: args.resume,
+            force: args.force,
             report: args.report,
             quiet: args.quiet,
         })
@@ -63,7 +66,15 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let out = opts
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from("export").join(&scene.name));
+        .unwrap_or_else(|| outdir::default_out(&scene));
+    if !opts.resume {
+        for f in outdir::prepare(&out, &scene, opts.force)? {
+            eprintln!(
+                "removed {} (it belonged to the previous solution)",
+                f.display()
+            );
+        }
+    }
     let problem = Problem::new(scene);
     let scene = &problem.scene;
     clock.lap("scene loading and set-up");

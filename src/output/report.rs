@@ -72,7 +72,8 @@ fn read_optional(path: &Path) -> Result<Option<Vec<u8>>, ExportError> {
     }
 }
 
-const STYLE: &str = "body{font-family:sans-serif;max-width:1240px;margin:1em auto;padding:0 1em;color:#222}\
+const STYLE: &str =
+    "body{font-family:sans-serif;max-width:1240px;margin:1em auto;padding:0 1em;color:#222}\
 h1{margin-bottom:0.2em}table{border-collapse:collapse;margin:0.5em 0 1.5em}\
 td,th{border:1px solid #ccc;padding:0.25em 0.6em;text-align:right}\
 th{background:#f0f0f0}td:first-child,th:first-child{text-align:left}\
@@ -114,7 +115,13 @@ pub fn report_html(dir: &Path, s: &Solution) -> Result<String, ExportError> {
     );
     // The scene's term order, not the file's alphabetical one; then any other key.
     let mut keys: Vec<String> = Term::ALL.iter().map(|t| t.key().to_string()).collect();
-    keys.extend(s.energy.keys().filter(|k| !keys.contains(k)).cloned().collect::<Vec<_>>());
+    keys.extend(
+        s.energy
+            .keys()
+            .filter(|k| !keys.contains(k))
+            .cloned()
+            .collect::<Vec<_>>(),
+    );
     for key in keys {
         let Some(v) = s.energy.get(&key) else {
             continue;
@@ -156,7 +163,11 @@ pub fn report_html(dir: &Path, s: &Solution) -> Result<String, ExportError> {
     }
     h.push_str("</table>\n<h2>Contacts before t</h2>\n");
     if s.n_contacts == 0 {
-        let _ = writeln!(h, "<p>No contact before t = {} s: every flight is free.</p>", s.t);
+        let _ = writeln!(
+            h,
+            "<p>No contact before t = {} s: every flight is free.</p>",
+            s.t
+        );
     } else {
         let _ = writeln!(
             h,

@@ -24,7 +24,12 @@ fn report_page_renders_the_overlay_and_tables_in_headless_chromium() {
         !html.contains("http://") && !html.contains("https://"),
         "the page must be self-contained"
     );
-    for part in ["<table", "data:image/png;base64,", "Launch", "v<sub>x</sub> (m/s)"] {
+    for part in [
+        "<table",
+        "data:image/png;base64,",
+        "Launch",
+        "v<sub>x</sub> (m/s)",
+    ] {
         assert!(html.contains(part), "{part} missing from the page");
     }
 
@@ -42,7 +47,10 @@ fn report_page_renders_the_overlay_and_tables_in_headless_chromium() {
             "--hide-scrollbars",
             "--force-device-scale-factor=1",
         ])
-        .arg(format!("--user-data-dir={}", work.join("profile").display()))
+        .arg(format!(
+            "--user-data-dir={}",
+            work.join("profile").display()
+        ))
         .arg(format!("--screenshot={}", shot.display()))
         .arg("--window-size=1280,2000")
         .arg(format!("file://{}", page.canonicalize().unwrap().display()))

@@ -188,7 +188,9 @@ pub fn overlay_figure(
                     .draw(&Rectangle::new([(x, 44), (x + 16, 60)], c.filled()))
                     .map_err(&err)?;
                 let label = format!("{name} ({n} px)");
-                caption.draw_text(&label, &small, (x + 22, 44)).map_err(&err)?;
+                caption
+                    .draw_text(&label, &small, (x + 22, 44))
+                    .map_err(&err)?;
                 let (w, _) = caption.estimate_text_size(&label, &small).map_err(&err)?;
                 x += 22 + w as i32 + 18;
             }

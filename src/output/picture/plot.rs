@@ -79,7 +79,11 @@ struct Pen {
 }
 
 fn draw_line<DB: DrawingBackend>(
-    chart: &mut ChartContext<'_, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>,
+    chart: &mut ChartContext<
+        '_,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
     points: Vec<(f64, f64)>,
     pen: Pen,
 ) -> Result<(), String> {
@@ -89,7 +93,9 @@ fn draw_line<DB: DrawingBackend>(
             .draw_series(DashedLineSeries::new(points, 7, 4, style))
             .map_err(e)?;
     } else {
-        chart.draw_series(LineSeries::new(points, style)).map_err(e)?;
+        chart
+            .draw_series(LineSeries::new(points, style))
+            .map_err(e)?;
     }
     Ok(())
 }
@@ -226,7 +232,10 @@ pub(super) fn generation_bests(rows: &[ConvergenceRow]) -> Vec<GenerationBest<'_
 
 /// Runs of drawable points of one series, split at stage boundaries and at missing
 /// values, so that no line joins two stages (whose weights differ).
-pub(super) fn runs(bests: &[GenerationBest], value: impl Fn(&ConvergenceRow) -> f64) -> Vec<Vec<(f64, f64)>> {
+pub(super) fn runs(
+    bests: &[GenerationBest],
+    value: impl Fn(&ConvergenceRow) -> f64,
+) -> Vec<Vec<(f64, f64)>> {
     let mut out: Vec<Vec<(f64, f64)>> = Vec::new();
     let mut prev_stage = None;
     for g in bests {
@@ -516,7 +525,9 @@ impl Draw for GridData {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         root.fill(&WHITE).map_err(e)?;
         let (header, body) = root.split_vertically(GRID_HEADER);
-        header.draw_text(&self.title, &font(19), (12, 8)).map_err(e)?;
+        header
+            .draw_text(&self.title, &font(19), (12, 8))
+            .map_err(e)?;
         let pens: Vec<Pen> = (0..3)
             .map(|i| Pen {
                 color: [PALETTE[0], PALETTE[2], PALETTE[3]][i],

@@ -31,7 +31,9 @@ fn overlay_gives_agreement_misses_and_extras_three_distinct_colours() {
     let colours = [AGREE, MISSED, EXTRA, WHITE];
     for (i, a) in colours.iter().enumerate() {
         for b in &colours[i + 1..] {
-            let d: i32 = (0..3).map(|k| (i32::from(a[k]) - i32::from(b[k])).abs()).sum();
+            let d: i32 = (0..3)
+                .map(|k| (i32::from(a[k]) - i32::from(b[k])).abs())
+                .sum();
             assert!(d > 150, "{a:?} and {b:?} are too alike");
         }
     }
@@ -109,7 +111,12 @@ fn convergence_plot_draws_png_and_svg_with_names_and_legend() {
     let pixels: Vec<_> = fig.png.pixels().copied().collect();
     assert!(pixels.iter().any(|p| p[0] < 20 && p[1] < 20 && p[2] < 20));
     assert!(pixels.contains(&Rgb([31, 119, 180])));
-    for text in ["demo", "stage 1: first", "stage 2: second", "best total so far"] {
+    for text in [
+        "demo",
+        "stage 1: first",
+        "stage 2: second",
+        "best total so far",
+    ] {
         assert!(fig.svg.contains(text), "{text} missing from the SVG");
     }
     // The term that is zero throughout has no legend entry.
@@ -139,7 +146,11 @@ fn generation_bests_and_runs_split_at_stages_and_missing_values() {
     assert_eq!(bests[0].row.total, 1.0);
     assert_eq!(bests[0].x, 1.0);
     let r = runs(&bests, |r| r.total);
-    assert_eq!(r.len(), 2, "the zero breaks the line and the stage starts a new one");
+    assert_eq!(
+        r.len(),
+        2,
+        "the zero breaks the line and the stage starts a new one"
+    );
 }
 
 #[test]
