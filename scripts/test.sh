@@ -1,10 +1,9 @@
 #!/usr/bin/env bash
 # Runs every test of the project on a fresh machine: it first installs what the tests
 # need (the Khronos glTF validator from npm, Blender's bpy module from PyPI in a local
-# virtualenv, Chromium from Debian's packages), then formatting, lints, the unit and integration tests (including the
-# ignored ones: the validator, the Blender cross-check and video, the report page in
-# headless Chromium) and a build of the
-# benchmarks. This is the README's test command; CI (.ci/run) calls it.
+# virtualenv, Chromium from Debian's packages), then formatting, lints, the unit and
+# integration tests (including the ignored ones: the validator, the Blender cross-check
+# and video, the report page in headless Chromium) and a build of the benchmarks. This is the README's test command; CI (.ci/run) calls it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
