@@ -25,6 +25,13 @@ fn bar(total: u64, template: &'static str, quiet: bool) -> ProgressBar {
     bar.set_style(
         ProgressStyle::with_template(template)
             .expect("static template")
+            // Rates read the same in every command: whole samples per second.
+            .with_key(
+                "rate",
+                |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                    let _ = write!(w, "{:.0} samples/s", state.per_sec());
+                },
+            )
             .progress_chars("=> "),
     );
     bar
@@ -243,7 +250,7 @@ impl crate::budget::Progress for BudgetProgress {
     fn start(&self, phase: &str, total: u64) {
         let bar = bar(
             total,
-            "{prefix} [{bar:30}] {pos}/{len} {per_sec} eta {eta}",
+            "{prefix} [{bar:30}] {pos}/{len} {rate} eta {eta}",
             self.quiet,
         );
         bar.set_prefix(phase.to_string());

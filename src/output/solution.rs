@@ -27,9 +27,12 @@ pub struct SampleRecord {
 pub struct OccluderLaunch {
     pub name: String,
     pub launched: bool,
-    /// Centre-of-mass launch velocity (m/s, world).
+    /// Centre-of-mass launch velocity (m/s, world). The key carries the unit; files
+    /// written before it did are still read.
+    #[serde(rename = "velocity_m_s", alias = "velocity")]
     pub velocity: [f64; 3],
     /// Launch angular velocity (rad/s, world).
+    #[serde(rename = "angular_velocity_rad_s", alias = "angular_velocity")]
     pub angular_velocity: [f64; 3],
 }
 
@@ -168,4 +171,23 @@ pub fn check_resumable(scene: &Scene, s: &Solution) -> Result<(), MismatchError>
         });
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn launch_keys_carry_units_and_old_files_still_read() {
+        let o = OccluderLaunch {
+            name: "a".into(),
+            launched: true,
+            velocity: [1.0, 2.0, 3.0],
+            angular_velocity: [4.0, 5.0, 6.0],
+        };
+        let text = serde_json::to_string(&o).unwrap();
+        assert!(text.contains("\"velocity_m_s\"") && text.contains("\"angular_velocity_rad_s\""));
+        let old = r#"{"name":"a","launched":true,"velocity":[1,2,3],"angular_velocity":[4,5,6]}"#;
+        assert_eq!(serde_json::from_str::<OccluderLaunch>(old).unwrap(), o);
+    }
 }
