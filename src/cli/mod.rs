@@ -139,9 +139,10 @@ struct VideoArgs {
     /// Cycles samples per pixel.
     #[arg(long, default_value_t = 4)]
     samples: u32,
-    /// Frame size in pixels.
+    /// Frame width in pixels.
     #[arg(long, default_value_t = 640)]
     width: u32,
+    /// Frame height in pixels.
     #[arg(long, default_value_t = 480)]
     height: u32,
     /// Render only the first SECONDS of the animation.
