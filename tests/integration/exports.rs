@@ -54,7 +54,8 @@ fn exported_glb_gives_the_solvers_poses_at_t() {
         assert_eq!(&row[col("name")], l.name.as_str());
         let speed: f64 = row[col("speed_m_s")].parse().unwrap();
         let v = l.velocity;
-        assert!((speed - (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()).abs() < 1e-9);
+        // launch.csv prints micrometres per second, the precision a launcher can use.
+        assert!((speed - (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()).abs() <= 5e-7);
     }
     let traj = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
     assert!(traj.starts_with("time_s,occluder,phase,x_m,y_m,z_m,qx,qy,qz,qw"));
