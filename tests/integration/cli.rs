@@ -82,7 +82,9 @@ fn solve_and_eval_from_the_command_line() {
         sol.to_str().unwrap(),
     ]);
     assert!(
-        ok && stdout.contains("XOR") && stdout.contains("total"),
+        ok && stdout.contains("xor")
+            && stdout.contains("d0 (0th moment)")
+            && stdout.contains("total"),
         "{stdout}"
     );
     // Resuming a complete solution does nothing and says so.
