@@ -349,7 +349,7 @@ mod csv_precision_tests {
         let mut w = csv::Writer::from_writer(Vec::new());
         w.serialize(Row {
             a: -0.000_035_271_897_876_898_05,
-            b: 0.707_106_781_186_547_6,
+            b: std::f64::consts::FRAC_1_SQRT_2,
             c: 1.234_567_890_123e-5,
         })
         .unwrap();
