@@ -128,8 +128,11 @@ impl Observer for SolveProgress {
         if let Some(bar) = self.bar.take() {
             bar.finish_and_clear();
         }
+        // Stage lines are results, like the summary that follows them: both go to stdout,
+        // so that they arrive in order wherever stdout and stderr are sent (the bars
+        // stay on stderr).
         if let Some(r) = s.stages.last() {
-            eprintln!(
+            println!(
                 "stage {}/{} `{}`: {} iterations, {} samples, best energy {:.4e}, IoU {:.4}, {:.2} s ({})",
                 s.stages_completed, s.stages_total, r.name, r.iterations, r.samples, r.best_energy, r.iou, r.wall_time_s, r.stop
             );

@@ -177,7 +177,10 @@ impl ConvergenceCsv {
     /// Start `dir/convergence.csv` with its header and `records`.
     pub fn create(dir: &Path, records: &[SampleRecord]) -> Result<ConvergenceCsv> {
         let path = dir.join("convergence.csv");
-        let mut header = vec!["stage".to_string(), "iteration".to_string()];
+        // Stages are numbered from 1 here as in the terminal and `eval --stage`; the
+        // column's name says so, and tells these files from older ones whose `stage`
+        // counted from 0 (still read by `read_convergence`).
+        let mut header = vec!["stage_number".to_string(), "iteration".to_string()];
         header.extend(Term::ALL.iter().map(|t| t.key().to_string()));
         header.push("total".into());
         let mut bytes = encode_rows(&path, |w| w.write_record(&header))?;
@@ -205,7 +208,7 @@ impl ConvergenceCsv {
 fn encode_records(path: &Path, records: &[SampleRecord]) -> Result<Vec<u8>> {
     encode_rows(path, |w| {
         for r in records {
-            let mut row = vec![r.stage.to_string(), r.iteration.to_string()];
+            let mut row = vec![(r.stage + 1).to_string(), r.iteration.to_string()];
             row.extend(r.terms.iter().map(|x| format!("{x:e}")));
             row.push(format!("{:e}", r.total));
             w.write_record(&row)?;
@@ -283,6 +286,11 @@ pub fn read_convergence(path: &Path, stages: usize) -> Result<Vec<SampleRecord>>
         message,
     };
     let mut r = csv::Reader::from_path(path).map_err(|e| bad(e.to_string()))?;
+    // Files written before stages were numbered from 1 name the column `stage`.
+    let first = match r.headers().map_err(|e| bad(e.to_string()))?.get(0) {
+        Some("stage") => 0,
+        _ => 1,
+    };
     let mut out = Vec::new();
     // A malformed row is an error unless it is the last one: a solve stopped in the
     // middle of appending a stage leaves a cut-off last row of a stage that was not
@@ -312,7 +320,11 @@ pub fn read_convergence(path: &Path, stages: usize) -> Result<Vec<SampleRecord>>
                 .parse::<f64>()
                 .map_err(|e| bad(format!("`{}`: {e}", &row[i])))
         };
-        let stage = row[0].parse::<usize>().map_err(|e| bad(e.to_string()))?;
+        let stage = row[0]
+            .parse::<usize>()
+            .map_err(|e| bad(e.to_string()))?
+            .checked_sub(first)
+            .ok_or_else(|| bad(format!("stage {} is below {first}", &row[0])))?;
         if stage >= stages {
             continue;
         }
@@ -369,6 +381,31 @@ mod tests {
             std::fs::read(&path).unwrap(),
             std::fs::read(d2.join("convergence.csv")).unwrap()
         );
+    }
+
+    #[test]
+    fn convergence_numbers_stages_from_1_and_reads_older_tables_from_0() {
+        let d = dir("numbering");
+        let all = records(2, 2);
+        ConvergenceCsv::create(&d, &all).unwrap();
+        let path = d.join("convergence.csv");
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.starts_with("stage_number,iteration,d0,"), "{text}");
+        assert!(text.lines().nth(1).unwrap().starts_with("1,0,"));
+        // An older table: column `stage`, stages from 0.
+        let old = text
+            .replacen("stage_number", "stage", 1)
+            .lines()
+            .enumerate()
+            .map(|(i, l)| match (i, l.split_once(',')) {
+                (0, _) | (_, None) => format!("{l}\n"),
+                (_, Some((n, rest))) => format!("{},{rest}\n", n.parse::<usize>().unwrap() - 1),
+            })
+            .collect::<String>();
+        let old_path = d.join("old.csv");
+        std::fs::write(&old_path, old).unwrap();
+        assert_eq!(read_convergence(&old_path, 2).unwrap(), all);
+        assert_eq!(read_convergence(&path, 2).unwrap(), all);
     }
 
     #[test]

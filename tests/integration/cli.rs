@@ -57,9 +57,9 @@ fn solve_and_eval_from_the_command_line() {
         1 + 2 * 5 * 12,
         "one row per sample plus the header"
     );
-    assert!(
-        csv.starts_with("stage,iteration,d0,d1,d2,xor,inner,outer,contact,reg,hint,barrier,total")
-    );
+    assert!(csv.starts_with(
+        "stage_number,iteration,d0,d1,d2,xor,inner,outer,contact,reg,hint,barrier,total"
+    ));
     let sol = out.join("solution.json");
     let (ok, stdout, err) = bsa(&[
         "eval",
