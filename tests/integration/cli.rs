@@ -48,8 +48,15 @@ fn solve_and_eval_from_the_command_line() {
         "preview.png",
         "convergence.csv",
         "convergence.png",
+        "convergence.svg",
+        "report.html",
+        "mickey.glb",
+        "launch.csv",
+        "trajectory.csv",
     ] {
         assert!(out.join(f).is_file(), "missing {f}");
+        // solve says what it wrote: every file, not only the exports.
+        assert!(stdout.contains(f), "solve did not list {f}: {stdout}");
     }
     let csv = std::fs::read_to_string(out.join("convergence.csv")).unwrap();
     assert_eq!(
