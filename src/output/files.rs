@@ -93,9 +93,63 @@ where
     write_atomic(path, &png_bytes(img, path)?)
 }
 
-/// `solution.json`.
+/// `path` relative to the folder `base`, both made absolute first (without resolving
+/// links); `None` when they share no root.
+fn relative_to(path: &Path, base: &Path) -> Option<PathBuf> {
+    use std::path::Component;
+    let path = std::path::absolute(path).ok()?;
+    let base = std::path::absolute(base).ok()?;
+    // `absolute` keeps `..` components; dropping them against their parent keeps the
+    // comparison below purely lexical and right for paths without symbolic links.
+    fn normal(p: &Path) -> Vec<Component<'_>> {
+        let mut out: Vec<Component> = Vec::new();
+        for c in p.components() {
+            match c {
+                Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
+                    out.pop();
+                }
+                Component::CurDir => {}
+                c => out.push(c),
+            }
+        }
+        out
+    }
+    let (p, b) = (normal(&path), normal(&base));
+    if p.first() != b.first() {
+        return None;
+    }
+    let common = p.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    let mut rel = PathBuf::new();
+    for _ in common..b.len() {
+        rel.push("..");
+    }
+    for c in &p[common..] {
+        rel.push(c.as_os_str());
+    }
+    Some(rel)
+}
+
+/// `solution.json`. The scene file is recorded relative to the output folder, so that a
+/// results folder moved or cloned together with its scene still finds it, and no
+/// absolute path of one machine is written; [`read_solution`] turns it back into a path
+/// usable from the current folder.
 pub fn write_solution(dir: &Path, s: &Solution) -> Result<()> {
     let path = dir.join("solution.json");
+    let relative;
+    let s = match s
+        .scene_file
+        .as_deref()
+        .and_then(|f| relative_to(Path::new(f), dir))
+    {
+        Some(rel) => {
+            relative = Solution {
+                scene_file: Some(rel.display().to_string()),
+                ..s.clone()
+            };
+            &relative
+        }
+        None => s,
+    };
     let text = serde_json::to_string_pretty(s).map_err(|e| ExportError::Encode {
         path: path.clone(),
         message: e.to_string(),
@@ -109,10 +163,16 @@ pub fn read_solution(path: &Path) -> Result<Solution> {
         path: path.to_path_buf(),
         source,
     })?;
-    serde_json::from_str(&text).map_err(|e| ExportError::BadSolution {
+    let mut s: Solution = serde_json::from_str(&text).map_err(|e| ExportError::BadSolution {
         path: path.to_path_buf(),
         message: e.to_string(),
-    })
+    })?;
+    // A relative scene file is relative to the solution's folder (older files hold an
+    // absolute path, which `join` keeps as it is).
+    if let (Some(f), Some(dir)) = (&s.scene_file, path.parent()) {
+        s.scene_file = Some(dir.join(f).display().to_string());
+    }
+    Ok(s)
 }
 
 /// The overlay of a shadow on the target at 1:1 (agreement grey, missed target blue,
@@ -381,6 +441,24 @@ mod tests {
             std::fs::read(&path).unwrap(),
             std::fs::read(d2.join("convergence.csv")).unwrap()
         );
+    }
+
+    #[test]
+    fn relative_paths_climb_out_of_the_base_and_down_to_the_file() {
+        assert_eq!(
+            relative_to(
+                Path::new("/a/scenes/m/scene.json"),
+                Path::new("/a/export/m")
+            ),
+            Some(PathBuf::from("../../scenes/m/scene.json"))
+        );
+        assert_eq!(
+            relative_to(Path::new("/a/b/../c/s.json"), Path::new("/a/c")),
+            Some(PathBuf::from("s.json"))
+        );
+        // From the current folder, as the solver records it and a reader resolves it.
+        let rel = relative_to(Path::new("scenes/m/scene.json"), Path::new("export/m")).unwrap();
+        assert_eq!(rel, PathBuf::from("../../scenes/m/scene.json"));
     }
 
     #[test]
