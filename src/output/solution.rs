@@ -60,8 +60,10 @@ pub struct StageReport {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Solution {
     pub scene: String,
-    /// The scene file the solution was made from (absolute when known); `export`,
-    /// `validate` and `video` find the scene through it unless told otherwise.
+    /// The scene file the solution was made from; `export`, `validate` and `video` find
+    /// the scene through it unless told otherwise. In memory it is a path usable from
+    /// the current folder; `solution.json` holds it relative to its own folder (see
+    /// `output::files::write_solution`).
     #[serde(default)]
     pub scene_file: Option<String>,
     pub seed: u64,
