@@ -246,6 +246,59 @@ mod tests {
         }
     }
 
+    fn solution() -> Solution {
+        let v = serde_json::json!({
+            "scene": "demo <1>", "scene_file": null, "seed": 1, "t": 1.2,
+            "stages_total": 1, "stages_completed": 1, "complete": true,
+            "occluders": [{"name": "ball", "launched": true,
+                "velocity_m_s": [0.000_035_271_9, 1.5, 6.25],
+                "angular_velocity_rad_s": [0.1, 0.2, 0.3]}],
+            "energy": {"xor": {"raw": 3.0, "weighted": 900.0},
+                       "d0": {"raw": 1.0, "weighted": 2.0}},
+            "total_energy": 902.0, "iou": 0.99, "t_sim": 1.2, "n_contacts": 0,
+            "samples": 10, "iterations": 2, "wall_time_s": 0.1, "threads": 2,
+            "time_per_term_us": {},
+            "stages": [{"name": "fine", "iterations": 2, "samples": 10, "population": 5,
+                "best_energy": 902.0, "iou": 0.99, "stop": "iteration cap",
+                "wall_time_s": 0.1}]
+        });
+        serde_json::from_value(v).unwrap()
+    }
+
+    #[test]
+    fn page_is_self_contained_with_units_terms_in_order_and_the_budget_when_present() {
+        let dir = std::env::temp_dir().join(format!("bsa-report-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("overlay.png"), b"png bytes").unwrap();
+        let page = report_html(&dir, &solution()).unwrap();
+        assert!(!page.contains("http://") && !page.contains("https://"));
+        assert!(page.contains("demo &lt;1&gt;"), "names are escaped");
+        assert!(page.contains(&format!("data:image/png;base64,{}", base64(b"png bytes"))));
+        assert!(page.contains("(m/s)") && page.contains("(rad/s)"));
+        // Micrometres per second, not 17 digits.
+        assert!(page.contains("<td>0.000035</td>"), "{page}");
+        // The scene's term order (d0 before xor), with the one vocabulary.
+        let (d0, xor) = (
+            page.find("d0 (0th moment)").unwrap(),
+            page.find(">xor<").unwrap(),
+        );
+        assert!(d0 < xor);
+        assert!(page.contains("No contact before t"));
+        assert!(!page.contains("Error budget"));
+        std::fs::write(
+            dir.join("budget.md"),
+            "# Budget\n![h](budget_hist.png)\n| a |\n",
+        )
+        .unwrap();
+        let page = report_html(&dir, &solution()).unwrap();
+        assert!(page.contains("Error budget") && page.contains("| a |"));
+        assert!(
+            !page.contains("![h]"),
+            "image links of the Markdown are dropped"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     #[test]
     fn html_text_is_escaped() {
         assert_eq!(esc("<a & \"b\">"), "&lt;a &amp; &quot;b&quot;&gt;");
