@@ -67,6 +67,8 @@ pub struct Solution {
     #[serde(default)]
     pub scene_file: Option<String>,
     pub seed: u64,
+    /// The instant the shadows form the picture (s).
+    #[serde(rename = "t_s", alias = "t")]
     pub t: f64,
     pub stages_total: usize,
     pub stages_completed: usize,
@@ -77,6 +79,8 @@ pub struct Solution {
     pub energy: std::collections::BTreeMap<String, TermValue>,
     pub total_energy: f64,
     pub iou: f64,
+    /// The first contact's time, or `t` without contact (s).
+    #[serde(rename = "t_sim_s", alias = "t_sim")]
     pub t_sim: f64,
     pub n_contacts: u32,
     pub samples: usize,
@@ -178,6 +182,29 @@ pub fn check_resumable(scene: &Scene, s: &Solution) -> Result<(), MismatchError>
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_older_solution_file_reads_and_is_written_with_units_in_its_keys() {
+        // solution.json as written before its keys carried units.
+        let old = serde_json::json!({
+            "scene": "demo", "scene_file": null, "seed": 1, "t": 1.2,
+            "stages_total": 1, "stages_completed": 1, "complete": true,
+            "occluders": [{"name": "ball", "launched": true,
+                "velocity": [1.0, 2.0, 3.0], "angular_velocity": [0.1, 0.2, 0.3]}],
+            "energy": {}, "total_energy": 1.0, "iou": 0.99, "t_sim": 1.1,
+            "n_contacts": 1, "samples": 10, "iterations": 2, "wall_time_s": 0.1,
+            "threads": 2, "time_per_term_us": {}, "stages": []
+        });
+        let s: Solution = serde_json::from_value(old).unwrap();
+        assert_eq!((s.t, s.t_sim), (1.2, 1.1));
+        assert_eq!(s.occluders[0].velocity, [1.0, 2.0, 3.0]);
+        let new = serde_json::to_value(&s).unwrap();
+        for key in ["t_s", "t_sim_s"] {
+            assert!(new.get(key).is_some(), "{key} missing");
+        }
+        assert!(new["occluders"][0].get("velocity_m_s").is_some());
+        assert_eq!(serde_json::from_value::<Solution>(new).unwrap(), s);
+    }
 
     #[test]
     fn launch_keys_carry_units_and_old_files_still_read() {
