@@ -317,6 +317,7 @@ impl Draw for ConvergencePlot<'_> {
 
         // Stage boundaries: a grey line where each stage after the first starts, and
         // every stage's number and name at the top of its span.
+        let pixel_width = f64::from(chart.plotting_area().dim_in_pixel().0);
         let mut starts: Vec<(usize, usize)> = Vec::new();
         for (i, r) in data.rows.iter().enumerate() {
             if starts.last().is_none_or(|&(s, _)| s != r.stage) {
@@ -333,17 +334,29 @@ impl Draw for ConvergencePlot<'_> {
                     )))
                     .map_err(e)?;
             }
-            let name = data
-                .stage_names
-                .get(stage)
-                .map_or(String::new(), |s| format!(": {s}"));
-            chart
-                .draw_series(std::iter::once(Text::new(
-                    format!("stage {}{name}", stage + 1),
-                    (x + n * 0.005, f64::from(hi) - 0.05 * f64::from(hi - lo)),
-                    font(13),
-                )))
-                .map_err(e)?;
+            // Each stage is labelled with the longest label that fits in its span: its
+            // number and name, its number alone, or nothing (THE THINKER has 33 stages).
+            let end = starts.get(k + 1).map_or(data.rows.len(), |&(_, j)| j);
+            let span_px = pixel_width * (end - i) as f64 / n;
+            let full = match data.stage_names.get(stage) {
+                Some(name) => format!("stage {}: {name}", stage + 1),
+                None => format!("stage {}", stage + 1),
+            };
+            let short = format!("{}", stage + 1);
+            let label = [full, short].into_iter().find(|l| {
+                plot_area
+                    .estimate_text_size(l, &font(13))
+                    .is_ok_and(|(w, _)| f64::from(w) + 8.0 <= span_px)
+            });
+            if let Some(label) = label {
+                chart
+                    .draw_series(std::iter::once(Text::new(
+                        label,
+                        (x + n * 0.004, f64::from(hi) - 0.05 * f64::from(hi - lo)),
+                        font(13),
+                    )))
+                    .map_err(e)?;
+            }
         }
 
         let bests = generation_bests(&data.rows);

@@ -191,3 +191,17 @@ fn budget_plots_draw_png_and_svg() {
     assert!(g.png.width() < 2 * g.png.height());
     assert!(g.svg.contains("largest tolerance"));
 }
+
+#[test]
+fn stage_labels_shrink_to_their_number_or_vanish_when_stages_are_narrow() {
+    let mut data = sample_data();
+    // One wide stage, then 60 narrow ones of a single generation each.
+    for stage in 2..62 {
+        data.rows.push(row(stage, 0, &[1.0, 0.1, 0.0]));
+        data.stage_names
+            .push(format!("narrow stage with a long name {stage}"));
+    }
+    let fig = plot::convergence(&data).unwrap();
+    assert!(fig.svg.contains("stage 1: first"));
+    assert!(!fig.svg.contains("narrow stage with a long name"));
+}
