@@ -1,7 +1,7 @@
 //! The `bsa` command line: the clap definitions and the dispatch to the subcommands.
 //!
 //! Subcommands: `check` (validate a scene and print a summary), `solve` (optimise and
-//! write `export/<scene>/`), `eval` (print every energy term of a saved solution),
+//! write `export/<scene folder>/` and its `report.html`), `eval` (print every energy term of a saved solution),
 //! `export` (animated glTF and launch tables of a saved solution), `validate` (Blender
 //! Cycles shadow against the rasterizer), `video` (an MP4 of the flight) and `budget`
 //! (air drag, the drag-compensated launch table and launch tolerances). `validate`
