@@ -6,7 +6,7 @@
 #
 # For every scene under scenes/ and every seed it solves (on all cores), then keeps
 # solution.json without its timing fields (wall times, time per phase, threads, the
-# absolute scene path), the SHA-256 of convergence.csv, shadow.png, overlay.png,
+# scene path), the SHA-256 of convergence.csv, shadow.png, overlay.png,
 # launch.csv, trajectory.csv and the glb, and the output of `bsa eval` and `bsa check`.
 # It also keeps `--help` of bsa and of every subcommand. Timing lines are dropped from
 # what the commands print; everything else is compared as is.

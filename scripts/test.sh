@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Runs every test of the project on a fresh machine: it first installs what the tests
 # need (the Khronos glTF validator from npm, Blender's bpy module from PyPI in a local
-# virtualenv), then formatting, lints, the unit and integration tests (including the
-# ignored ones: the validator, the Blender cross-check and video) and a build of the
-# benchmarks. This is the README's test command; CI (.ci/run) calls it.
+# virtualenv, Chromium from Debian's packages), then formatting, lints, the unit and
+# integration tests (including the ignored ones: the validator, the Blender cross-check
+# and video, the report page in headless Chromium) and a build of the benchmarks. This is the README's test command; CI (.ci/run) calls it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -11,6 +11,15 @@ echo "== setup: Khronos glTF validator (npm, pinned by tools/gltf-validator/pack
 (cd tools/gltf-validator && npm ci --no-audit --no-fund --loglevel=error)
 echo "== setup: Blender bpy in .venv-blender (PyPI, pinned by blender/requirements.txt)"
 bash blender/setup_venv.sh
+
+echo "== setup: Chromium (Debian's package) for the report page's browser test"
+if ! command -v chromium >/dev/null; then
+    if [ "$(id -u)" -eq 0 ]; then
+        apt-get update && apt-get install -y chromium
+    else
+        sudo apt-get update && sudo apt-get install -y chromium
+    fi
+fi
 
 echo "== cargo fmt --check"
 cargo fmt --check

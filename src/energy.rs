@@ -94,6 +94,17 @@ impl Term {
         }
     }
 
+    /// The one name of a term for people: its file key and what it measures, as
+    /// "d0 (0th moment)", so that the plots, tables and terminal read the same name the
+    /// files use.
+    pub fn display_name(self) -> String {
+        if self.label().eq_ignore_ascii_case(self.key()) {
+            self.key().to_string()
+        } else {
+            format!("{} ({})", self.key(), self.label())
+        }
+    }
+
     /// Parse a scene-file key; a few long aliases are accepted too.
     pub fn from_key(key: &str) -> Option<Term> {
         let t = match key {

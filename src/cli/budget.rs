@@ -121,15 +121,17 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         })
     ));
     files::write_atomic(&dir.join("budget.md"), md.as_bytes())?;
-    files::save_png(&plots::histogram(r), &dir.join("budget_hist.png"))?;
-    let tolerances_png = dir.join("budget_tolerances.png");
+    files::save_figure(&dir, "budget_hist", &plots::histogram(r)?)?;
     match plots::tolerances(r) {
-        Some(img) => files::save_png(&img, &tolerances_png)?,
+        Some(figure) => files::save_figure(&dir, "budget_tolerances", &figure?)?,
         // No search this time: a plot left by an earlier run would not match budget.json.
         None => {
-            if tolerances_png.is_file() {
-                std::fs::remove_file(&tolerances_png)
-                    .with_context(|| format!("removing the stale {}", tolerances_png.display()))?;
+            for ext in ["png", "svg"] {
+                let stale = dir.join(format!("budget_tolerances.{ext}"));
+                if stale.is_file() {
+                    std::fs::remove_file(&stale)
+                        .with_context(|| format!("removing the stale {}", stale.display()))?;
+                }
             }
         }
     }
@@ -180,14 +182,17 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             se.joint_scale
         );
     }
+    // The solve's report page shows the budget too, so it is rewritten with it.
+    let report = crate::output::report::write_report(&dir, &solution)?;
     println!(
-        "wrote {}/{{budget.md, budget.json, launch_drag.csv, budget_hist.png{}}} in {elapsed:.2} s",
+        "wrote {}/{{budget.md, budget.json, launch_drag.csv, budget_hist.png, budget_hist.svg{}, report.html}} in {elapsed:.2} s",
         dir.display(),
         if r.search.is_some() {
-            ", budget_tolerances.png"
+            ", budget_tolerances.png, budget_tolerances.svg"
         } else {
             ""
         }
     );
+    println!("report: {}", report.display());
     Ok(())
 }

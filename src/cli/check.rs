@@ -33,6 +33,10 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let s = load::scene(&opts.scene)?;
     println!("scene `{}` ({})", s.name, s.source.display());
     println!(
+        "  results  {}/ (where `bsa solve` writes without --out)",
+        super::outdir::default_out(&s).display()
+    );
+    println!(
         "  target   {} x {} px, {} shadow pixels ({:.1}%)",
         s.target.width(),
         s.target.height(),
@@ -40,15 +44,15 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         100.0 * s.target.count() as f64 / (s.target.width() * s.target.height()) as f64
     );
     println!(
-        "  t        {} s, timestep {:.5} s, gravity {}",
+        "  t        {} s, timestep {:.5} s, gravity {} m/s^2",
         s.t,
         s.dt,
         fmt_vec(s.gravity)
     );
-    println!("  light    {}", fmt_vec(s.light));
+    println!("  light    {} m", fmt_vec(s.light));
     let r = &s.receiver;
     println!(
-        "  receiver centre {}, u {}, v {}, {} m x {} m ({:.4} m/px)",
+        "  receiver centre {} m, u {}, v {}, {} m x {} m ({:.4} m/px)",
         fmt_vec(r.center),
         fmt_vec(r.u),
         fmt_vec(r.v),
@@ -58,7 +62,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     );
     match &s.table {
         Some(t) => println!(
-            "  table    top at z = {:.3} m, centre {}, size {}",
+            "  table    top at z = {:.3} m, centre {} m, size {} m",
             t.top(),
             fmt_vec(t.center),
             fmt_vec(t.half_extents * 2.0)
@@ -69,7 +73,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     for o in &s.occluders {
         let shape = match &o.shape {
             Shape::Sphere { radius } => format!("sphere r {radius} m"),
-            Shape::Cuboid { half_extents } => format!("box {}", fmt_vec(*half_extents * 2.0)),
+            Shape::Cuboid { half_extents } => format!("box {} m", fmt_vec(*half_extents * 2.0)),
             Shape::Mesh(m) => format!(
                 "mesh {} vertices, {} triangles",
                 m.vertices.len(),
@@ -77,7 +81,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             ),
         };
         println!(
-            "    {:<12} {:<34} {:>8.4} kg  at {}  {}",
+            "    {:<12} {:<36} {:>8.4} kg  at {} m  {}",
             o.name,
             shape,
             o.mass.mass,

@@ -118,13 +118,19 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             scene.stages[k - 1].name
         );
         println!(
-            "{:<16} {:>14} {:>10} {:>14}",
+            "{:<24} {:>14} {:>10} {:>14}",
             "term", "raw", "weight", "weighted"
         );
         for (t, raw, w, wt) in &rows {
-            println!("{:<16} {:>14.6} {:>10} {:>14.6}", t.label(), raw, w, wt);
+            println!(
+                "{:<24} {:>14.6} {:>10} {:>14.6}",
+                t.display_name(),
+                raw,
+                w,
+                wt
+            );
         }
-        println!("{:<16} {:>14} {:>10} {:>14.6}", "total", "", "", total);
+        println!("{:<24} {:>14} {:>10} {:>14.6}", "total", "", "", total);
         println!(
             "IoU at t {:.5}; t_sim {:.5} s; contacts {}",
             e.iou, e.outcome.t_sim, e.outcome.n_contacts

@@ -1,7 +1,7 @@
 //! The `bsa` command line: the clap definitions and the dispatch to the subcommands.
 //!
 //! Subcommands: `check` (validate a scene and print a summary), `solve` (optimise and
-//! write `export/<scene>/`), `eval` (print every energy term of a saved solution),
+//! write `export/<scene folder>/` and its `report.html`), `eval` (print every energy term of a saved solution),
 //! `export` (animated glTF and launch tables of a saved solution), `validate` (Blender
 //! Cycles shadow against the rasterizer), `video` (an MP4 of the flight) and `budget`
 //! (air drag, the drag-compensated launch table and launch tolerances), and `render`
@@ -24,6 +24,7 @@ mod export;
 pub mod guard;
 mod load;
 mod new;
+mod outdir;
 mod plant;
 mod progress;
 mod render;
@@ -54,7 +55,8 @@ enum Command {
     /// Validate a scene and print a summary.
     Check(CheckArgs),
     /// Optimise launch velocities and write solution.json, shadow.png, overlay.png,
-    /// convergence.csv and convergence.png.
+    /// preview.png, convergence.{csv,png,svg}, report.html, <scene>.glb, launch.csv and
+    /// trajectory.csv.
     Solve(SolveArgs),
     /// Write the animated glTF (<scene>.glb), launch.csv and trajectory.csv of a saved solution.
     Export(ExportArgs),
@@ -93,9 +95,12 @@ struct CheckArgs {
 struct SolveArgs {
     /// Scene folder (holding scene.json) or scene file.
     scene: PathBuf,
-    /// Output folder [default: export/<scene name>].
+    /// Output folder [default: export/<name of the scene's folder>].
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Replace the results of another scene (or another t) found in the output folder.
+    #[arg(long)]
+    force: bool,
     /// Random seed (overrides the scene's).
     #[arg(long)]
     seed: Option<u64>,
@@ -150,9 +155,10 @@ struct VideoArgs {
     /// Cycles samples per pixel.
     #[arg(long, default_value_t = 4)]
     samples: u32,
-    /// Frame size in pixels.
+    /// Frame width in pixels.
     #[arg(long, default_value_t = 640)]
     width: u32,
+    /// Frame height in pixels.
     #[arg(long, default_value_t = 480)]
     height: u32,
     /// Render only the first SECONDS of the animation.

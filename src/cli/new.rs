@@ -104,9 +104,12 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         &Weights::default(),
         &mut ws,
     );
-    files::write_preview(dir, &problem.scene.target, &ws.mask)?;
-    std::fs::rename(dir.join("preview.png"), dir.join("start.png"))
-        .with_context(|| format!("cannot write {}", dir.join("start.png").display()))?;
+    files::save_overlay(
+        &dir.join("start.png"),
+        &problem.scene.target,
+        &ws.mask,
+        &format!("{name}: the start guess at t, before any solve"),
+    )?;
     println!(
         "{}: {} objects; start guess IoU {:.4}{}; wrote {}/{{scene.json, target.png, start.png}}; next: bsa solve {}",
         name,

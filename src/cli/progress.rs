@@ -25,6 +25,13 @@ fn bar(total: u64, template: &'static str, quiet: bool) -> ProgressBar {
     bar.set_style(
         ProgressStyle::with_template(template)
             .expect("static template")
+            // Rates read the same in every command: whole samples per second.
+            .with_key(
+                "rate",
+                |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                    let _ = write!(w, "{:.0} samples/s", state.per_sec());
+                },
+            )
             .progress_chars("=> "),
     );
     bar
@@ -121,8 +128,11 @@ impl Observer for SolveProgress {
         if let Some(bar) = self.bar.take() {
             bar.finish_and_clear();
         }
+        // Stage lines are results, like the summary that follows them: both go to stdout,
+        // so that they arrive in order wherever stdout and stderr are sent (the bars
+        // stay on stderr).
         if let Some(r) = s.stages.last() {
-            eprintln!(
+            println!(
                 "stage {}/{} `{}`: {} iterations, {} samples, best energy {:.4e}, IoU {:.4}, {:.2} s ({})",
                 s.stages_completed, s.stages_total, r.name, r.iterations, r.samples, r.best_energy, r.iou, r.wall_time_s, r.stop
             );
@@ -243,7 +253,7 @@ impl crate::budget::Progress for BudgetProgress {
     fn start(&self, phase: &str, total: u64) {
         let bar = bar(
             total,
-            "{prefix} [{bar:30}] {pos}/{len} {per_sec} eta {eta}",
+            "{prefix} [{bar:30}] {pos}/{len} {rate} eta {eta}",
             self.quiet,
         );
         bar.set_prefix(phase.to_string());

@@ -67,7 +67,13 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     }
     std::fs::create_dir_all(&opts.out)
         .with_context(|| format!("cannot create {}", opts.out.display()))?;
-    files::write_pictures(&opts.out, &scene.target, &ws.mask)?;
+    let title = format!(
+        "{}: the shadow at {} s of {}",
+        scene.name,
+        at,
+        opts.solution.display()
+    );
+    files::write_pictures(&opts.out, &scene.target, &ws.mask, &title)?;
     let contact = match e.outcome.first_contact {
         None => "no contact before t".to_string(),
         Some((i, j)) => format!(

@@ -14,7 +14,7 @@ use crate::output::files;
 use crate::output::solution::{self, Solution};
 
 use super::progress::SolveProgress;
-use super::{export, guard, load, SolveArgs};
+use super::{export, guard, load, outdir, SolveArgs};
 
 /// Ctrl-C presses so far. The solver reads it between iterations: one press ends the
 /// current stage, a second one stops and saves the best so far.
@@ -26,12 +26,14 @@ const MAX_THREADS: usize = 1024;
 /// The validated options of `bsa solve`.
 pub(super) struct Options {
     scene: PathBuf,
-    /// `None`: `export/<scene name>`, known once the scene is loaded.
+    /// `None`: `export/<scene folder's name>`, known once the scene is loaded.
     out: Option<PathBuf>,
     seed: Option<u64>,
     /// Between 1 and [`MAX_THREADS`] when given.
     threads: Option<usize>,
     resume: bool,
+    /// Replace another scene's results in the output folder.
+    force: bool,
     report: bool,
     quiet: bool,
 }
@@ -50,6 +52,7 @@ impl Options {
             seed: args.seed,
             threads: args.threads,
             resume: args.resume,
+            force: args.force,
             report: args.report,
             quiet: args.quiet,
         })
@@ -65,7 +68,15 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let out = opts
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from("export").join(&scene.name));
+        .unwrap_or_else(|| outdir::default_out(&scene));
+    if !opts.resume {
+        for f in outdir::prepare(&out, &scene, opts.force)? {
+            eprintln!(
+                "removed {} (it belonged to the previous solution)",
+                f.display()
+            );
+        }
+    }
     let problem = Problem::new(scene);
     clock.lap("scene loading and set-up");
     let scene = &problem.scene;
@@ -181,7 +192,7 @@ fn solve_into(
     files::write_solution(&out, &solution)?;
     let mut all = prior;
     all.extend(records);
-    files::write_convergence_plot(&out, &observer.stage_names, &all)?;
+    files::write_convergence_plot(&out, &scene.name, &observer.stage_names, &all)?;
     clock.lap("solution, convergence table and plot");
     if keep_previous && solution.stages_completed < solution.stages_total {
         return Ok(solution);
@@ -189,7 +200,8 @@ fn solve_into(
     let mut ws = problem.workspace();
     let params = solution.parameters();
     problem.evaluate(&params, &Weights::all_ones(), &mut ws);
-    files::write_pictures(&out, &scene.target, &ws.mask)?;
+    let title = format!("{}: shadow at t = {} s", scene.name, scene.t);
+    files::write_pictures(&out, &scene.target, &ws.mask, &title)?;
     files::write_preview(&out, &scene.target, &ws.mask)?;
     clock.lap("shadow, overlay and preview");
     let exported = export::write_exports(
@@ -199,6 +211,8 @@ fn solve_into(
         crate::output::trajectory::DEFAULT_AFTER,
     )?;
     clock.lap("exports (motion after t, glb, CSV)");
+    let report = crate::output::report::write_report(&out, &solution)?;
+    clock.lap("report page");
     println!(
         "{}: IoU at t {:.4}, {} before t ({} contacts), {} samples in {} iterations, {:.2} s on {} threads{}",
         scene.name,
@@ -215,7 +229,12 @@ fn solve_into(
         solution.threads,
         if solution.complete { "" } else { " (stopped early)" }
     );
+    println!(
+        "wrote {}/{{solution.json, convergence.csv, convergence.png, convergence.svg, shadow.png, overlay.png, preview.png}}",
+        out.display()
+    );
     println!("{exported}");
+    println!("report: {}", report.display());
     if opts.report {
         print_report(&solution, &clock);
     }

@@ -36,6 +36,12 @@ pub enum ExportError {
     BadConvergence { path: PathBuf, message: String },
     #[error("cannot encode {path}: {message}")]
     Encode { path: PathBuf, message: String },
+    #[error("cannot draw {path}")]
+    Picture {
+        path: PathBuf,
+        #[source]
+        source: picture::PictureError,
+    },
 }
 
 type Result<T> = std::result::Result<T, ExportError>;
@@ -95,9 +101,63 @@ where
     write_atomic(path, &png_bytes(img, path)?)
 }
 
-/// `solution.json`.
+/// `path` relative to the folder `base`, both made absolute first (without resolving
+/// links); `None` when they share no root.
+fn relative_to(path: &Path, base: &Path) -> Option<PathBuf> {
+    use std::path::Component;
+    let path = std::path::absolute(path).ok()?;
+    let base = std::path::absolute(base).ok()?;
+    // `absolute` keeps `..` components; dropping them against their parent keeps the
+    // comparison below purely lexical and right for paths without symbolic links.
+    fn normal(p: &Path) -> Vec<Component<'_>> {
+        let mut out: Vec<Component> = Vec::new();
+        for c in p.components() {
+            match c {
+                Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
+                    out.pop();
+                }
+                Component::CurDir => {}
+                c => out.push(c),
+            }
+        }
+        out
+    }
+    let (p, b) = (normal(&path), normal(&base));
+    if p.first() != b.first() {
+        return None;
+    }
+    let common = p.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    let mut rel = PathBuf::new();
+    for _ in common..b.len() {
+        rel.push("..");
+    }
+    for c in &p[common..] {
+        rel.push(c.as_os_str());
+    }
+    Some(rel)
+}
+
+/// `solution.json`. The scene file is recorded relative to the output folder, so that a
+/// results folder moved or cloned together with its scene still finds it, and no
+/// absolute path of one machine is written; [`read_solution`] turns it back into a path
+/// usable from the current folder.
 pub fn write_solution(dir: &Path, s: &Solution) -> Result<()> {
     let path = dir.join("solution.json");
+    let relative;
+    let s = match s
+        .scene_file
+        .as_deref()
+        .and_then(|f| relative_to(Path::new(f), dir))
+    {
+        Some(rel) => {
+            relative = Solution {
+                scene_file: Some(rel.display().to_string()),
+                ..s.clone()
+            };
+            &relative
+        }
+        None => s,
+    };
     let text = serde_json::to_string_pretty(s).map_err(|e| ExportError::Encode {
         path: path.clone(),
         message: e.to_string(),
@@ -111,32 +171,63 @@ pub fn read_solution(path: &Path) -> Result<Solution> {
         path: path.to_path_buf(),
         source,
     })?;
-    serde_json::from_str(&text).map_err(|e| ExportError::BadSolution {
+    let mut s: Solution = serde_json::from_str(&text).map_err(|e| ExportError::BadSolution {
         path: path.to_path_buf(),
         message: e.to_string(),
-    })
+    })?;
+    // A relative scene file is relative to the solution's folder (older files hold an
+    // absolute path, which `join` keeps as it is).
+    if let (Some(f), Some(dir)) = (&s.scene_file, path.parent()) {
+        s.scene_file = Some(dir.join(f).display().to_string());
+    }
+    Ok(s)
 }
 
-/// The overlay of a shadow on the target (target black, shadow translucent red).
-pub fn overlay(target: &Mask, shadow: &Mask) -> image::RgbImage {
-    picture::overlay_image(
+/// The overlay of a shadow on the target at 1:1 (agreement grey, missed target blue,
+/// extra shadow red) with `title`, the IoU and a legend below it.
+pub fn overlay(
+    target: &Mask,
+    shadow: &Mask,
+    title: &str,
+) -> std::result::Result<image::RgbImage, picture::PictureError> {
+    picture::overlay_figure(
         target.width(),
         target.height(),
         &|x, y| target.get(x, y),
         &|x, y| shadow.get(x, y),
+        title,
     )
 }
 
-/// `shadow.png` (the mask at t) and `overlay.png`.
-pub fn write_pictures(dir: &Path, target: &Mask, shadow: &Mask) -> Result<()> {
+pub fn save_overlay(path: &Path, target: &Mask, shadow: &Mask, title: &str) -> Result<()> {
+    let img = overlay(target, shadow, title).map_err(|source| ExportError::Picture {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    save_png(&img, path)
+}
+
+/// `shadow.png` (the mask at t) and `overlay.png` (captioned with `title`).
+pub fn write_pictures(dir: &Path, target: &Mask, shadow: &Mask, title: &str) -> Result<()> {
     let img = picture::mask_image(shadow.width(), shadow.height(), &|x, y| shadow.get(x, y));
     save_png(&img, &dir.join("shadow.png"))?;
-    save_png(&overlay(target, shadow), &dir.join("overlay.png"))
+    save_overlay(&dir.join("overlay.png"), target, shadow, title)
 }
 
 /// `preview.png`: the overlay of the best shadow so far.
 pub fn write_preview(dir: &Path, target: &Mask, shadow: &Mask) -> Result<()> {
-    save_png(&overlay(target, shadow), &dir.join("preview.png"))
+    save_overlay(
+        &dir.join("preview.png"),
+        target,
+        shadow,
+        "preview: best shadow so far",
+    )
+}
+
+/// Save a plot as `<stem>.png` and `<stem>.svg` in `dir`.
+pub fn save_figure(dir: &Path, stem: &str, figure: &picture::plot::Figure) -> Result<()> {
+    save_png(&figure.png, &dir.join(format!("{stem}.png")))?;
+    write_atomic(&dir.join(format!("{stem}.svg")), figure.svg.as_bytes())
 }
 
 /// `convergence.csv` (every sample: stage, iteration, each weighted term, total), grown
@@ -154,7 +245,10 @@ impl ConvergenceCsv {
     /// Start `dir/convergence.csv` with its header and `records`.
     pub fn create(dir: &Path, records: &[SampleRecord]) -> Result<ConvergenceCsv> {
         let path = dir.join("convergence.csv");
-        let mut header = vec!["stage".to_string(), "iteration".to_string()];
+        // Stages are numbered from 1 here as in the terminal and `eval --stage`; the
+        // column's name says so, and tells these files from older ones whose `stage`
+        // counted from 0 (still read by `read_convergence`).
+        let mut header = vec!["stage_number".to_string(), "iteration".to_string()];
         header.extend(Term::ALL.iter().map(|t| t.key().to_string()));
         header.push("total".into());
         let mut bytes = encode_rows(&path, |w| w.write_record(&header))?;
@@ -182,7 +276,7 @@ impl ConvergenceCsv {
 fn encode_records(path: &Path, records: &[SampleRecord]) -> Result<Vec<u8>> {
     encode_rows(path, |w| {
         for r in records {
-            let mut row = vec![r.stage.to_string(), r.iteration.to_string()];
+            let mut row = vec![(r.stage + 1).to_string(), r.iteration.to_string()];
             row.extend(r.terms.iter().map(|x| format!("{x:e}")));
             row.push(format!("{:e}", r.total));
             w.write_record(&row)?;
@@ -210,18 +304,21 @@ fn encode_rows(
     Ok(bytes)
 }
 
-/// `convergence.png`: one log-scale panel per stage.
+/// `convergence.png` and `convergence.svg`: every term and the total against the sample
+/// index, stage by stage (see [`picture::plot::convergence`]).
 pub fn write_convergence_plot(
     dir: &Path,
+    scene: &str,
     stage_names: &[String],
     records: &[SampleRecord],
 ) -> Result<()> {
-    let data = picture::ConvergenceData {
+    let data = picture::plot::ConvergenceData {
+        scene: scene.to_string(),
         stage_names: stage_names.to_vec(),
-        term_names: Term::ALL.iter().map(|t| t.label().to_string()).collect(),
+        term_names: Term::ALL.iter().map(|t| t.display_name()).collect(),
         rows: records
             .iter()
-            .map(|r| picture::ConvergenceRow {
+            .map(|r| picture::plot::ConvergenceRow {
                 stage: r.stage,
                 iteration: r.iteration,
                 terms: r.terms.to_vec(),
@@ -229,8 +326,11 @@ pub fn write_convergence_plot(
             })
             .collect(),
     };
-    let img = picture::convergence_plot(&data, 520, 380);
-    save_png(&img, &dir.join("convergence.png"))
+    let figure = picture::plot::convergence(&data).map_err(|source| ExportError::Picture {
+        path: dir.join("convergence.png"),
+        source,
+    })?;
+    save_figure(dir, "convergence", &figure)
 }
 
 /// Write rows as a CSV file (header from the field names), atomically.
@@ -254,6 +354,11 @@ pub fn read_convergence(path: &Path, stages: usize) -> Result<Vec<SampleRecord>>
         message,
     };
     let mut r = csv::Reader::from_path(path).map_err(|e| bad(e.to_string()))?;
+    // Files written before stages were numbered from 1 name the column `stage`.
+    let first = match r.headers().map_err(|e| bad(e.to_string()))?.get(0) {
+        Some("stage") => 0,
+        _ => 1,
+    };
     let mut out = Vec::new();
     // A malformed row is an error unless it is the last one: a solve stopped in the
     // middle of appending a stage leaves a cut-off last row of a stage that was not
@@ -283,7 +388,11 @@ pub fn read_convergence(path: &Path, stages: usize) -> Result<Vec<SampleRecord>>
                 .parse::<f64>()
                 .map_err(|e| bad(format!("`{}`: {e}", &row[i])))
         };
-        let stage = row[0].parse::<usize>().map_err(|e| bad(e.to_string()))?;
+        let stage = row[0]
+            .parse::<usize>()
+            .map_err(|e| bad(e.to_string()))?
+            .checked_sub(first)
+            .ok_or_else(|| bad(format!("stage {} is below {first}", &row[0])))?;
         if stage >= stages {
             continue;
         }
@@ -340,6 +449,49 @@ mod tests {
             std::fs::read(&path).unwrap(),
             std::fs::read(d2.join("convergence.csv")).unwrap()
         );
+    }
+
+    #[test]
+    fn relative_paths_climb_out_of_the_base_and_down_to_the_file() {
+        assert_eq!(
+            relative_to(
+                Path::new("/a/scenes/m/scene.json"),
+                Path::new("/a/export/m")
+            ),
+            Some(PathBuf::from("../../scenes/m/scene.json"))
+        );
+        assert_eq!(
+            relative_to(Path::new("/a/b/../c/s.json"), Path::new("/a/c")),
+            Some(PathBuf::from("s.json"))
+        );
+        // From the current folder, as the solver records it and a reader resolves it.
+        let rel = relative_to(Path::new("scenes/m/scene.json"), Path::new("export/m")).unwrap();
+        assert_eq!(rel, PathBuf::from("../../scenes/m/scene.json"));
+    }
+
+    #[test]
+    fn convergence_numbers_stages_from_1_and_reads_older_tables_from_0() {
+        let d = dir("numbering");
+        let all = records(2, 2);
+        ConvergenceCsv::create(&d, &all).unwrap();
+        let path = d.join("convergence.csv");
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.starts_with("stage_number,iteration,d0,"), "{text}");
+        assert!(text.lines().nth(1).unwrap().starts_with("1,0,"));
+        // An older table: column `stage`, stages from 0.
+        let old = text
+            .replacen("stage_number", "stage", 1)
+            .lines()
+            .enumerate()
+            .map(|(i, l)| match (i, l.split_once(',')) {
+                (0, _) | (_, None) => format!("{l}\n"),
+                (_, Some((n, rest))) => format!("{},{rest}\n", n.parse::<usize>().unwrap() - 1),
+            })
+            .collect::<String>();
+        let old_path = d.join("old.csv");
+        std::fs::write(&old_path, old).unwrap();
+        assert_eq!(read_convergence(&old_path, 2).unwrap(), all);
+        assert_eq!(read_convergence(&path, 2).unwrap(), all);
     }
 
     #[test]

@@ -2,12 +2,13 @@
 //! `convergence.csv`, and the check that a solution belongs to a scene), [`files`]
 //! (atomic writes and reads of the output folder), [`trajectory`] (the whole motion and
 //! the launch and trajectory tables), [`gltf`] (the animated glTF 2.0 file) and
-//! [`picture`] (overlays and plots for people).
+//! [`picture`] (overlays and plots for people) and [`report`] (`report.html`).
 
 pub mod cycles;
 pub mod files;
 pub mod gltf;
 pub mod launches;
 pub mod picture;
+pub mod report;
 pub mod solution;
 pub mod trajectory;

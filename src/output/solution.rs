@@ -27,9 +27,12 @@ pub struct SampleRecord {
 pub struct OccluderLaunch {
     pub name: String,
     pub launched: bool,
-    /// Centre-of-mass launch velocity (m/s, world).
+    /// Centre-of-mass launch velocity (m/s, world). The key carries the unit; files
+    /// written before it did are still read.
+    #[serde(rename = "velocity_m_s", alias = "velocity")]
     pub velocity: [f64; 3],
     /// Launch angular velocity (rad/s, world).
+    #[serde(rename = "angular_velocity_rad_s", alias = "angular_velocity")]
     pub angular_velocity: [f64; 3],
 }
 
@@ -57,11 +60,15 @@ pub struct StageReport {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Solution {
     pub scene: String,
-    /// The scene file the solution was made from (absolute when known); `export`,
-    /// `validate` and `video` find the scene through it unless told otherwise.
+    /// The scene file the solution was made from; `export`, `validate` and `video` find
+    /// the scene through it unless told otherwise. In memory it is a path usable from
+    /// the current folder; `solution.json` holds it relative to its own folder (see
+    /// `output::files::write_solution`).
     #[serde(default)]
     pub scene_file: Option<String>,
     pub seed: u64,
+    /// The instant the shadows form the picture (s).
+    #[serde(rename = "t_s", alias = "t")]
     pub t: f64,
     pub stages_total: usize,
     pub stages_completed: usize,
@@ -72,6 +79,8 @@ pub struct Solution {
     pub energy: std::collections::BTreeMap<String, TermValue>,
     pub total_energy: f64,
     pub iou: f64,
+    /// The first contact's time, or `t` without contact (s).
+    #[serde(rename = "t_sim_s", alias = "t_sim")]
     pub t_sim: f64,
     pub n_contacts: u32,
     pub samples: usize,
@@ -168,4 +177,46 @@ pub fn check_resumable(scene: &Scene, s: &Solution) -> Result<(), MismatchError>
         });
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_older_solution_file_reads_and_is_written_with_units_in_its_keys() {
+        // solution.json as written before its keys carried units.
+        let old = serde_json::json!({
+            "scene": "demo", "scene_file": null, "seed": 1, "t": 1.2,
+            "stages_total": 1, "stages_completed": 1, "complete": true,
+            "occluders": [{"name": "ball", "launched": true,
+                "velocity": [1.0, 2.0, 3.0], "angular_velocity": [0.1, 0.2, 0.3]}],
+            "energy": {}, "total_energy": 1.0, "iou": 0.99, "t_sim": 1.1,
+            "n_contacts": 1, "samples": 10, "iterations": 2, "wall_time_s": 0.1,
+            "threads": 2, "time_per_term_us": {}, "stages": []
+        });
+        let s: Solution = serde_json::from_value(old).unwrap();
+        assert_eq!((s.t, s.t_sim), (1.2, 1.1));
+        assert_eq!(s.occluders[0].velocity, [1.0, 2.0, 3.0]);
+        let new = serde_json::to_value(&s).unwrap();
+        for key in ["t_s", "t_sim_s"] {
+            assert!(new.get(key).is_some(), "{key} missing");
+        }
+        assert!(new["occluders"][0].get("velocity_m_s").is_some());
+        assert_eq!(serde_json::from_value::<Solution>(new).unwrap(), s);
+    }
+
+    #[test]
+    fn launch_keys_carry_units_and_old_files_still_read() {
+        let o = OccluderLaunch {
+            name: "a".into(),
+            launched: true,
+            velocity: [1.0, 2.0, 3.0],
+            angular_velocity: [4.0, 5.0, 6.0],
+        };
+        let text = serde_json::to_string(&o).unwrap();
+        assert!(text.contains("\"velocity_m_s\"") && text.contains("\"angular_velocity_rad_s\""));
+        let old = r#"{"name":"a","launched":true,"velocity":[1,2,3],"angular_velocity":[4,5,6]}"#;
+        assert_eq!(serde_json::from_str::<OccluderLaunch>(old).unwrap(), o);
+    }
 }

@@ -85,6 +85,24 @@ pub fn track(problem: &Problem, params: &[f64], after: f64) -> Track {
     out
 }
 
+/// Rounds to 6 decimals: micrometres, micrometres per second, microradians per second
+/// and microdegrees, the precision a launcher or a reader can use; more digits are the
+/// solver's and rapier's (f32) noise.
+fn micro<S: serde::Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_f64((x * 1e6).round() / 1e6)
+}
+
+/// Rounds to 9 decimals, for unit quaternions and unit axes.
+fn nano<S: serde::Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_f64((x * 1e9).round() / 1e9)
+}
+
+/// Rounds to 9 significant digits, for masses and moments of inertia, whose scale
+/// differs from scene to scene.
+fn sig9<S: serde::Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_f64(format!("{x:.8e}").parse().unwrap_or(*x))
+}
+
 /// One row of `launch.csv`: everything a builder needs to launch one occluder. Column
 /// names carry their units.
 #[derive(Clone, Debug, Serialize)]
@@ -92,50 +110,81 @@ pub struct LaunchRow {
     pub name: String,
     pub shape: String,
     pub launched: bool,
+    #[serde(serialize_with = "sig9")]
     pub mass_kg: f64,
     /// Centre-of-mass position at launch (m).
+    #[serde(serialize_with = "micro")]
     pub com_x_m: f64,
+    #[serde(serialize_with = "micro")]
     pub com_y_m: f64,
+    #[serde(serialize_with = "micro")]
     pub com_z_m: f64,
     /// Orientation at launch, body -> world (unit quaternion).
+    #[serde(serialize_with = "nano")]
     pub qx: f64,
+    #[serde(serialize_with = "nano")]
     pub qy: f64,
+    #[serde(serialize_with = "nano")]
     pub qz: f64,
+    #[serde(serialize_with = "nano")]
     pub qw: f64,
-    /// Centre-of-mass launch velocity (m/s).
+    /// Centre-of-mass launch velocity (m/s). The launch itself keeps every digit (the
+    /// shortest decimal that reads back as the same f64), so that `bsa render` of this
+    /// table gives the solve's shadow bit for bit; the columns derived from it are
+    /// rounded.
     pub vx_m_s: f64,
     pub vy_m_s: f64,
     pub vz_m_s: f64,
+    #[serde(serialize_with = "micro")]
     pub speed_m_s: f64,
     /// Angle above the horizontal (deg).
+    #[serde(serialize_with = "micro")]
     pub elevation_deg: f64,
     /// Direction in the horizontal plane, from +x toward +y (deg).
+    #[serde(serialize_with = "micro")]
     pub azimuth_deg: f64,
-    /// Launch angular velocity, world frame (rad/s).
+    /// Launch angular velocity, world frame (rad/s), every digit as the velocity.
     pub wx_rad_s: f64,
     pub wy_rad_s: f64,
     pub wz_rad_s: f64,
+    #[serde(serialize_with = "micro")]
     pub spin_rev_s: f64,
     /// Spin axis in the body frame (unit; zero without spin).
+    #[serde(serialize_with = "nano")]
     pub spin_axis_body_x: f64,
+    #[serde(serialize_with = "nano")]
     pub spin_axis_body_y: f64,
+    #[serde(serialize_with = "nano")]
     pub spin_axis_body_z: f64,
     /// Principal moments of inertia about the centre of mass (kg m^2).
+    #[serde(serialize_with = "sig9")]
     pub inertia_1_kg_m2: f64,
+    #[serde(serialize_with = "sig9")]
     pub inertia_2_kg_m2: f64,
+    #[serde(serialize_with = "sig9")]
     pub inertia_3_kg_m2: f64,
     /// Centre of mass in the body frame (m).
+    #[serde(serialize_with = "micro")]
     pub com_offset_x_m: f64,
+    #[serde(serialize_with = "micro")]
     pub com_offset_y_m: f64,
+    #[serde(serialize_with = "micro")]
     pub com_offset_z_m: f64,
     /// Predicted centre-of-mass position at t (m).
+    #[serde(serialize_with = "micro")]
     pub com_at_t_x_m: f64,
+    #[serde(serialize_with = "micro")]
     pub com_at_t_y_m: f64,
+    #[serde(serialize_with = "micro")]
     pub com_at_t_z_m: f64,
     /// Predicted orientation at t (body -> world).
+    #[serde(serialize_with = "nano")]
     pub q_at_t_x: f64,
+    #[serde(serialize_with = "nano")]
     pub q_at_t_y: f64,
+    #[serde(serialize_with = "nano")]
     pub q_at_t_z: f64,
+    #[serde(serialize_with = "nano")]
     pub q_at_t_w: f64,
 }
 
@@ -220,26 +269,43 @@ pub fn launch_rows(problem: &Problem, params: &[f64]) -> Vec<LaunchRow> {
 /// One row of `trajectory.csv`: one occluder's pose at one key.
 #[derive(Clone, Debug, Serialize)]
 pub struct TrajectoryRow {
+    #[serde(serialize_with = "micro")]
     pub time_s: f64,
     pub occluder: String,
     /// `flight` (the solver's exact model, up to and including t) or `continuation` (rapier, after t).
     pub phase: &'static str,
     /// Body-frame origin (m).
+    #[serde(serialize_with = "micro")]
     pub x_m: f64,
+    #[serde(serialize_with = "micro")]
     pub y_m: f64,
+    #[serde(serialize_with = "micro")]
     pub z_m: f64,
     /// Body -> world orientation.
+    #[serde(serialize_with = "nano")]
     pub qx: f64,
+    #[serde(serialize_with = "nano")]
     pub qy: f64,
+    #[serde(serialize_with = "nano")]
     pub qz: f64,
+    #[serde(serialize_with = "nano")]
     pub qw: f64,
 }
 
 /// The rows of `trajectory.csv` for a track.
 pub fn trajectory_rows(problem: &Problem, tr: &Track) -> Vec<TrajectoryRow> {
     let mut rows = Vec::with_capacity(tr.times.len() * problem.scene.occluders.len());
+    // q and -q are the same rotation; rapier's continuation may hand either, so each
+    // body's sign is kept continuous from key to key, which a reader interpolating the
+    // table needs.
+    let mut previous: Vec<Option<DQuat>> = vec![None; problem.scene.occluders.len()];
     for (k, (time, poses)) in tr.times.iter().zip(&tr.poses).enumerate() {
-        for (o, (p, q)) in problem.scene.occluders.iter().zip(poses) {
+        for ((o, (p, q)), prev) in problem.scene.occluders.iter().zip(poses).zip(&mut previous) {
+            let q = match prev {
+                Some(before) if before.dot(*q) < 0.0 => -*q,
+                _ => *q,
+            };
+            *prev = Some(q);
             rows.push(TrajectoryRow {
                 time_s: *time,
                 occluder: o.name.clone(),
@@ -259,4 +325,32 @@ pub fn trajectory_rows(problem: &Problem, tr: &Track) -> Vec<TrajectoryRow> {
         }
     }
     rows
+}
+
+#[cfg(test)]
+mod csv_precision_tests {
+    use super::*;
+
+    #[derive(Serialize)]
+    struct Row {
+        #[serde(serialize_with = "micro")]
+        a: f64,
+        #[serde(serialize_with = "nano")]
+        b: f64,
+        #[serde(serialize_with = "sig9")]
+        c: f64,
+    }
+
+    #[test]
+    fn tables_print_the_digits_that_mean_something() {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.serialize(Row {
+            a: -0.000_035_271_897_876_898_05,
+            b: std::f64::consts::FRAC_1_SQRT_2,
+            c: 1.234_567_890_123e-5,
+        })
+        .unwrap();
+        let text = String::from_utf8(w.into_inner().unwrap()).unwrap();
+        assert_eq!(text, "a,b,c\n-0.000035,0.707106781,0.0000123456789\n");
+    }
 }

@@ -48,8 +48,15 @@ fn solve_and_eval_from_the_command_line() {
         "preview.png",
         "convergence.csv",
         "convergence.png",
+        "convergence.svg",
+        "report.html",
+        "mickey.glb",
+        "launch.csv",
+        "trajectory.csv",
     ] {
         assert!(out.join(f).is_file(), "missing {f}");
+        // solve says what it wrote: every file, not only the exports.
+        assert!(stdout.contains(f), "solve did not list {f}: {stdout}");
     }
     let csv = std::fs::read_to_string(out.join("convergence.csv")).unwrap();
     assert_eq!(
@@ -57,9 +64,9 @@ fn solve_and_eval_from_the_command_line() {
         1 + 2 * 5 * 12,
         "one row per sample plus the header"
     );
-    assert!(
-        csv.starts_with("stage,iteration,d0,d1,d2,xor,inner,outer,contact,reg,hint,barrier,total")
-    );
+    assert!(csv.starts_with(
+        "stage_number,iteration,d0,d1,d2,xor,inner,outer,contact,reg,hint,barrier,total"
+    ));
     let sol = out.join("solution.json");
     let (ok, stdout, err) = bsa(&[
         "eval",
@@ -82,7 +89,9 @@ fn solve_and_eval_from_the_command_line() {
         sol.to_str().unwrap(),
     ]);
     assert!(
-        ok && stdout.contains("XOR") && stdout.contains("total"),
+        ok && stdout.contains("xor")
+            && stdout.contains("d0 (0th moment)")
+            && stdout.contains("total"),
         "{stdout}"
     );
     // Resuming a complete solution does nothing and says so.
@@ -184,4 +193,111 @@ fn bad_input_to_export_validate_and_video() {
     std::fs::write(out.join("solution.json"), "[1, 2").unwrap();
     let (ok, _, err) = bsa(&["export", out.to_str().unwrap()]);
     assert!(!ok && err.contains("not a valid solution file"), "{err}");
+}
+
+/// Runs `bsa` in `cwd`: (success, stdout, stderr).
+fn bsa_in(cwd: &Path, args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_bsa"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("run bsa");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn copied_scene_with_the_original_name_never_touches_the_originals_results() {
+    // A short Mickey in folder `mickey`, and a copy in folder `mickey_copy` that keeps
+    // the JSON name `mickey` but has another t (the trap of issue #15).
+    let base = tmpdir("trap");
+    let src = variant("trap-src", |v| {
+        for s in v["stages"].as_array_mut().unwrap() {
+            s["max_iterations"] = 3.into();
+            s["population"] = 8.into();
+        }
+    });
+    let copy_scene = |folder: &str, t: Option<f64>| {
+        let d = base.join(folder);
+        std::fs::create_dir_all(&d).unwrap();
+        std::fs::copy(src.join("target.png"), d.join("target.png")).unwrap();
+        let mut v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(src.join("scene.json")).unwrap())
+                .unwrap();
+        if let Some(t) = t {
+            v["t"] = t.into();
+        }
+        std::fs::write(d.join("scene.json"), v.to_string()).unwrap();
+        d
+    };
+    let original = copy_scene("mickey", None);
+    let copy = copy_scene("mickey_copy", Some(1.1));
+    let work = base.join("work");
+    std::fs::create_dir_all(&work).unwrap();
+    let (ok, stdout, err) = bsa_in(&work, &["check", copy.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(
+        stdout.contains("export/mickey_copy/"),
+        "check must say where: {stdout}"
+    );
+
+    let (ok, _, err) = bsa_in(&work, &["solve", original.to_str().unwrap(), "-q"]);
+    assert!(ok, "{err}");
+    let results = work.join("export/mickey");
+    let before = std::fs::read(results.join("solution.json")).unwrap();
+    std::fs::write(results.join("budget.md"), "the original's budget").unwrap();
+
+    // The copy goes to its own folder by default.
+    let (ok, _, err) = bsa_in(&work, &["solve", copy.to_str().unwrap(), "-q"]);
+    assert!(ok, "{err}");
+    assert!(work.join("export/mickey_copy/solution.json").is_file());
+    assert_eq!(
+        std::fs::read(results.join("solution.json")).unwrap(),
+        before
+    );
+    assert!(results.join("budget.md").is_file());
+
+    // Sent into the original's folder, it stops with a clear message and writes nothing.
+    let (ok, _, err) = bsa_in(
+        &work,
+        &[
+            "solve",
+            copy.to_str().unwrap(),
+            "-q",
+            "--out",
+            "export/mickey",
+        ],
+    );
+    assert!(!ok);
+    assert!(
+        err.contains("holds the results of") && err.contains("--force"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(results.join("solution.json")).unwrap(),
+        before
+    );
+    assert!(results.join("budget.md").is_file());
+
+    // With --force it replaces them and removes the stale budget.
+    let (ok, _, err) = bsa_in(
+        &work,
+        &[
+            "solve",
+            copy.to_str().unwrap(),
+            "-q",
+            "--out",
+            "export/mickey",
+            "--force",
+        ],
+    );
+    assert!(ok, "{err}");
+    assert_ne!(
+        std::fs::read(results.join("solution.json")).unwrap(),
+        before
+    );
+    assert!(!results.join("budget.md").exists(), "stale budget kept");
 }

@@ -9,8 +9,9 @@
 //!   solves, the lock);
 //! - `fuzz`: scene mutations generated from the schema, run through `check` and a short
 //!   solve under a timeout.
+//! - `report`: `report.html` rendered by headless Chromium.
 //!
-//! The tests that need an outside tool (Node's Khronos glTF validator, Blender's bpy) are
+//! The tests that need an outside tool (Node's Khronos glTF validator, Blender's bpy, Chromium) are
 //! `#[ignore]`d with the reason, so `cargo test` lists them as ignored; when run
 //! (`cargo test -- --include-ignored`, as `scripts/test.sh` does after installing both)
 //! they run for real and a missing tool fails them.
@@ -20,6 +21,7 @@ mod cli;
 mod exports;
 mod fuzz;
 mod render;
+mod report;
 mod robust;
 mod scene_errors;
 mod solver;

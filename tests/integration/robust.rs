@@ -223,6 +223,8 @@ fn an_interrupted_solve_keeps_the_previous_complete_solution() {
             "--out",
             out.to_str().unwrap(),
             "--quiet",
+            // Another scene file than the one the folder holds: replacing it is meant.
+            "--force",
         ])
         .current_dir(root())
         .stdout(Stdio::null())
