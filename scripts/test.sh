@@ -28,6 +28,10 @@ cargo clippy --all-targets --locked -- -D warnings
 # The tests that need the validator or bpy are #[ignore]d so that a plain `cargo test`
 # lists them as ignored; --include-ignored runs them too, for real (a missing tool fails).
 echo "== cargo test (with the ignored Blender and validator tests: --include-ignored)"
-cargo test --locked -- --include-ignored
+cargo test --locked -- --include-ignored --skip fuzz::
+# The fuzz harness on its own, with its output, so that its "N/M handled cleanly" lines
+# show in the log.
+echo "== fuzz harness"
+cargo test --locked --test integration fuzz:: -- --nocapture --test-threads 1
 echo "== cargo bench --no-run"
 cargo bench --no-run --locked
