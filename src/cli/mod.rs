@@ -268,6 +268,22 @@ struct NewArgs {
     /// The picture (PNG; dark = shadow).
     #[arg(long, value_name = "PNG")]
     target: PathBuf,
+    #[command(flatten)]
+    design: DesignArgs,
+}
+
+// Raw arguments of `bsa plant`.
+#[derive(Args)]
+struct PlantArgs {
+    /// Folder to write the problem into (created if needed).
+    dir: PathBuf,
+    #[command(flatten)]
+    design: DesignArgs,
+}
+
+// The objects and the stage of `bsa new` and `bsa plant`.
+#[derive(Args)]
+struct DesignArgs {
     /// The objects: comma-separated sphere:R, box:XxYxZ or mesh:FILE.obj[@SCALE], each
     /// with an optional *N count and /DENSITY (metres, kg/m^3; default 705, maple).
     #[arg(long)]
@@ -296,47 +312,9 @@ struct NewArgs {
         allow_negative_numbers = true
     )]
     t: f64,
-    /// Seed of the scene's solve.
+    /// Seed of the scene's solve (and of `plant`'s draw).
     #[arg(long, default_value_t = 1)]
     seed: u64,
-}
-
-// Raw arguments of `bsa plant`.
-#[derive(Args)]
-struct PlantArgs {
-    /// Folder to write the problem into (created if needed).
-    dir: PathBuf,
-    /// The objects: comma-separated sphere:R, box:XxYxZ or mesh:FILE.obj[@SCALE], each
-    /// with an optional *N count and /DENSITY (metres, kg/m^3; default 705, maple).
-    #[arg(long)]
-    objects: String,
-    /// Seed of the draw (and of the scene's solve).
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-    /// The picture's width on the floor (m); its height is 3/4 of it.
-    #[arg(
-        long,
-        value_name = "M",
-        default_value_t = 1.6,
-        allow_negative_numbers = true
-    )]
-    width: f64,
-    /// The point light's height above the picture (m).
-    #[arg(
-        long,
-        value_name = "M",
-        default_value_t = 6.0,
-        allow_negative_numbers = true
-    )]
-    light_height: f64,
-    /// The instant of the picture (s after the launch).
-    #[arg(
-        long,
-        value_name = "S",
-        default_value_t = 1.2,
-        allow_negative_numbers = true
-    )]
-    t: f64,
 }
 
 /// Run the parsed command line: validate the subcommand's options, then run it.

@@ -8,12 +8,13 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 
 use crate::design::cover;
-use crate::design::inventory::{self, Item};
+use crate::design::inventory::Item;
 use crate::design::plant::{Layout, Stage};
 use crate::energy::Weights;
 use crate::evaluate::Problem;
 use crate::output::files;
 
+use super::plant::Design;
 use super::{load, NewArgs};
 
 /// The validated options of `bsa new`.
@@ -27,27 +28,13 @@ pub(super) struct Options {
 
 impl Options {
     pub(super) fn new(args: NewArgs) -> Result<Options> {
-        let items = inventory::parse(&args.objects).context("--objects")?;
-        for (name, value, lo, hi) in [
-            ("--width", args.width, 0.01, 1000.0),
-            ("--light-height", args.light_height, 0.1, 1000.0),
-            ("--t", args.t, 0.05, 60.0),
-        ] {
-            if !(value.is_finite() && value >= lo && value <= hi) {
-                bail!("{name} must be between {lo} and {hi}, got {value}");
-            }
-        }
+        let design = Design::new(args.design)?;
         Ok(Options {
             dir: args.dir,
             target: args.target,
-            items,
-            seed: args.seed,
-            stage: Stage {
-                picture_width: args.width,
-                light_height: args.light_height,
-                t: args.t,
-                ..Stage::default()
-            },
+            items: design.items,
+            seed: design.seed,
+            stage: design.stage,
         })
     }
 }

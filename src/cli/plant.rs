@@ -13,7 +13,7 @@ use crate::output::{files, picture};
 use crate::scene::Launch;
 use crate::shadow::mask::Mask;
 
-use super::{load, PlantArgs};
+use super::{load, DesignArgs, PlantArgs};
 
 /// Draws before `bsa plant` gives up on an inventory.
 const ATTEMPTS: usize = 2000;
@@ -28,6 +28,25 @@ pub(super) struct Options {
 
 impl Options {
     pub(super) fn new(args: PlantArgs) -> Result<Options> {
+        let design = Design::new(args.design)?;
+        Ok(Options {
+            dir: args.dir,
+            items: design.items,
+            seed: design.seed,
+            stage: design.stage,
+        })
+    }
+}
+
+/// The validated objects and stage of `bsa new` and `bsa plant`.
+pub(super) struct Design {
+    pub(super) items: Vec<Item>,
+    pub(super) seed: u64,
+    pub(super) stage: Stage,
+}
+
+impl Design {
+    pub(super) fn new(args: DesignArgs) -> Result<Design> {
         let items = inventory::parse(&args.objects).context("--objects")?;
         for (name, value, lo, hi) in [
             ("--width", args.width, 0.01, 1000.0),
@@ -38,8 +57,7 @@ impl Options {
                 bail!("{name} must be between {lo} and {hi}, got {value}");
             }
         }
-        Ok(Options {
-            dir: args.dir,
+        Ok(Design {
             items,
             seed: args.seed,
             stage: Stage {
