@@ -3,6 +3,15 @@
 use clap::Parser;
 
 fn main() {
+    // Output piped into `head` and the like: end quietly when the reader goes away, as
+    // command-line tools do, instead of panicking on the failed write. Rust ignores
+    // SIGPIPE by default; this puts the default action back.
+    #[cfg(unix)]
+    // SAFETY: setting a signal's disposition to its default at start-up, before any
+    // thread exists, has no preconditions.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = bsa::cli::Cli::parse();
     if let Err(err) = bsa::cli::run(cli) {
         eprintln!("error: {err}");

@@ -416,3 +416,20 @@ fn solve_and_export_of_75k_and_100k_triangle_spheres_do_not_panic() {
         assert!(out.join("mickey.glb").is_file());
     }
 }
+
+#[test]
+fn output_piped_into_a_reader_that_goes_away_is_no_panic() {
+    // `bsa check scene | head -1`: the reader closes the pipe after one line.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bsa"))
+        .args(["check", "scenes/thinker"])
+        .current_dir(root())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_ne!(out.status.code(), Some(101), "{err}");
+}
