@@ -131,7 +131,9 @@ impl Layout {
             let n = counts.entry(stem.clone()).or_insert(0);
             *n += 1;
             let name = format!("{stem}_{n}");
-            let gap = 0.05;
+            // Room between neighbours, so that the start guesses, which send them off in
+            // different directions, do not meet right after the launch.
+            let gap = (0.5 * foot.x.max(foot.y)).max(0.05);
             if x > 0.0 && x + foot.x > row_length {
                 x = 0.0;
                 y -= row_depth + gap;
