@@ -55,6 +55,29 @@ fn import_keeps_animation_light_cameras_and_frame_range() {
     assert_eq!(v["lights"]["light"]["type"], "POINT");
     let light = &v["poses_at_t"]["light"]["location"];
     assert!((light[2].as_f64().unwrap() - 6.0).abs() < 1e-5, "{light}");
+    // Each occluder's launch arrives as custom properties (glTF node extras).
+    let solution: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("solution.json")).unwrap()).unwrap();
+    for o in solution["occluders"].as_array().unwrap() {
+        let name = o["name"].as_str().unwrap();
+        let props = &v["custom_properties"][name];
+        assert_eq!(props["scene"], "mickey", "{name}: {props}");
+        assert_eq!(props["launched"], o["launched"], "{name}: {props}");
+        assert!(props["mass_kg"].as_f64().unwrap() > 0.0, "{name}: {props}");
+        for (key, sol_key) in [
+            ("launch_velocity_m_s", "velocity_m_s"),
+            ("angular_velocity_rad_s", "angular_velocity_rad_s"),
+        ] {
+            for k in 0..3 {
+                let got = props[key][k].as_f64().unwrap();
+                let want = o[sol_key][k].as_f64().unwrap();
+                assert!(
+                    (got - want).abs() < 1e-9,
+                    "{name} {key}[{k}]: {got} vs {want}"
+                );
+            }
+        }
+    }
     // The animation plays: each occluder is where the solver put it at t.
     let p = Problem::new(bsa::scene::load(&root().join("scenes/mickey")).unwrap());
     let sol = bsa::output::files::read_solution(&out.join("solution.json")).unwrap();

@@ -27,7 +27,7 @@ use json::validation::{Checked::Valid, USize64};
 use json::Index;
 
 use crate::geometry::shape::{Shape, TriMesh};
-use crate::output::trajectory::Track;
+use crate::output::trajectory::{LaunchRow, Track};
 use crate::scene::Scene;
 
 mod build;
@@ -102,6 +102,9 @@ pub enum GltfError {
         expected: usize,
         got: usize,
     },
+    /// `write_glb_with_launches`: not one launch per occluder.
+    #[error("{got} launches for {expected} occluders")]
+    LaunchCount { expected: usize, got: usize },
     /// `write_glb`: a key time is negative, not finite, or not strictly after the previous
     /// one once stored as f32 (glTF stores times as f32; keys closer than its resolution
     /// would collapse).
@@ -152,7 +155,28 @@ pub enum GltfError {
 /// of those nodes is the pose at `t`, so that a viewer that ignores animations shows the
 /// picture.
 pub fn write_glb(scene: &Scene, traj: &Track) -> Result<Vec<u8>, GltfError> {
+    write_glb_with_launches(scene, traj, None)
+}
+
+/// As [`write_glb`], with each occluder's launch (`launches[i]` for occluder `i`, as
+/// written to launch.csv) in its node's `extras`, which Blender's importer turns into
+/// custom properties: `scene`, `launched`, `mass_kg`, `launch_velocity_m_s` and
+/// `angular_velocity_rad_s` (vectors in the project's Z-up world frame, which is also
+/// Blender's). Without launches the extras hold only `scene`.
+pub fn write_glb_with_launches(
+    scene: &Scene,
+    traj: &Track,
+    launches: Option<&[LaunchRow]>,
+) -> Result<Vec<u8>, GltfError> {
     check_input(scene, traj)?;
+    if let Some(l) = launches {
+        if l.len() != scene.occluders.len() {
+            return Err(GltfError::LaunchCount {
+                expected: scene.occluders.len(),
+                got: l.len(),
+            });
+        }
+    }
     let mut b = Builder::new();
 
     let mut scene_nodes = Vec::new();
@@ -176,7 +200,18 @@ pub fn write_glb(scene: &Scene, traj: &Track) -> Result<Vec<u8>, GltfError> {
         let material = b.material(&occ.name, occluder_colour(i), 0.5);
         let mesh = b.mesh(&occ.name, &data, material)?;
         let (o, q) = traj.poses[traj.t_index][i];
+        let extras = match launches.map(|l| &l[i]) {
+            Some(l) => serde_json::json!({
+                "scene": scene.name,
+                "launched": l.launched,
+                "mass_kg": l.mass_kg,
+                "launch_velocity_m_s": [l.vx_m_s, l.vy_m_s, l.vz_m_s],
+                "angular_velocity_rad_s": [l.wx_rad_s, l.wy_rad_s, l.wz_rad_s],
+            }),
+            None => serde_json::json!({ "scene": scene.name }),
+        };
         let node = b.root.push(json::Node {
+            extras: Some(serde_json::value::to_raw_value(&extras)?),
             mesh: Some(mesh),
             name: Some(occ.name.clone()),
             translation: Some(to_f32(pos_to_gltf(o))),

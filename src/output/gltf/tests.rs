@@ -463,3 +463,20 @@ fn bad_input_is_reported() {
         Err(GltfError::Parse(_))
     ));
 }
+
+#[test]
+fn occluder_nodes_carry_extras_and_launches_must_match() {
+    let scene = mickey();
+    let traj = ballistic(&scene);
+    let d = doc(&write_glb(&scene, &traj).unwrap());
+    for occ in &scene.occluders {
+        let node = d.nodes().find(|n| n.name() == Some(&occ.name)).unwrap();
+        let extras: serde_json::Value =
+            serde_json::from_str(node.extras().as_ref().unwrap().get()).unwrap();
+        assert_eq!(extras["scene"], scene.name.as_str());
+    }
+    assert!(matches!(
+        write_glb_with_launches(&scene, &traj, Some(&[])),
+        Err(GltfError::LaunchCount { got: 0, .. })
+    ));
+}
