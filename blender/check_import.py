@@ -6,7 +6,9 @@ Prints one line `BSA_RESULT {...}` with: fps, the frame range (set to 0 .. last 
 the glTF importer sets none), the frame of t, the cameras (type, ortho scale, lens), the
 lights (type, energy in W), the number of actions and animated objects, and the world
 pose of every object at the frame of t (location, quaternion w x y z; Blender is Z-up
-like the solver's world). The test suite compares those poses with the solver's.
+like the solver's world), and every object's custom properties (from the glTF node extras:
+mass_kg, launch_velocity_m_s, angular_velocity_rad_s, launched, scene). The test suite compares
+those poses and properties with the solver's.
 """
 
 import argparse
@@ -16,6 +18,21 @@ import sys
 sys.dont_write_bytecode = True
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bsa_blender as B  # noqa: E402
+
+
+def plain(value):
+    """A custom property as plain JSON: ID property arrays and groups become lists and dicts."""
+    if hasattr(value, "to_dict"):
+        return {k: plain(v) for k, v in value.to_dict().items()}
+    if hasattr(value, "to_list"):
+        return [plain(v) for v in value.to_list()]
+    if isinstance(value, (list, tuple)):
+        return [plain(v) for v in value]
+    if isinstance(value, dict):
+        return {k: plain(v) for k, v in value.items()}
+    if isinstance(value, (bool, int, float, str)) or value is None:
+        return value
+    return str(value)
 
 
 def main():
@@ -42,7 +59,11 @@ def main():
     cameras = {}
     lights = {}
     poses = {}
+    props = {}
     for o in imported:
+        keys = [k for k in o.keys() if not k.startswith("_")]
+        if keys:
+            props[B.base_name(o.name)] = {k: plain(o[k]) for k in keys}
         if o.type == "CAMERA":
             cameras[B.base_name(o.name)] = {
                 "type": o.data.type,
@@ -70,6 +91,7 @@ def main():
         "actions": len(bpy.data.actions),
         "animated_objects": animated,
         "poses_at_t": poses,
+        "custom_properties": props,
     })
 
 

@@ -61,13 +61,11 @@ pub(super) fn write_exports(
     let params = solution.parameters();
     let track = crate::output::trajectory::track(problem, &params, after);
     let name = &problem.scene.name;
-    let glb = crate::output::gltf::write_glb(&problem.scene, &track)
+    let launches = crate::output::trajectory::launch_rows(problem, &params);
+    let glb = crate::output::gltf::write_glb_with_launches(&problem.scene, &track, Some(&launches))
         .context("cannot build the glTF file")?;
     files::write_atomic(&dir.join(format!("{name}.glb")), &glb)?;
-    files::write_csv(
-        &dir.join("launch.csv"),
-        &crate::output::trajectory::launch_rows(problem, &params),
-    )?;
+    files::write_csv(&dir.join("launch.csv"), &launches)?;
     files::write_csv(
         &dir.join("trajectory.csv"),
         &crate::output::trajectory::trajectory_rows(problem, &track),

@@ -8,7 +8,7 @@ use std::process::Command;
 
 use bsa::evaluate::Problem;
 
-use crate::util::{bsa, example_scenes, quick_solve, require, root};
+use crate::util::{bsa, example_scenes, quick_solve, require, root, tmpdir};
 
 #[test]
 #[ignore = "needs Blender's bpy in .venv-blender (bash blender/setup_venv.sh); run by scripts/test.sh"]
@@ -36,19 +36,8 @@ fn import_keeps_animation_light_cameras_and_frame_range() {
         "bash blender/setup_venv.sh",
     );
     let out = quick_solve(&root().join("scenes/mickey"), "blender-import");
-    let o = Command::new(root().join(".venv-blender/bin/python"))
-        .arg(root().join("blender/check_import.py"))
-        .args(["--", "--glb"])
-        .arg(out.join("mickey.glb"))
-        .output()
-        .expect("the bpy virtualenv (bash blender/setup_venv.sh)");
-    let stdout = String::from_utf8_lossy(&o.stdout);
-    let line = stdout
-        .lines()
-        .rev()
-        .find_map(|l| l.strip_prefix("BSA_RESULT "))
-        .unwrap_or_else(|| panic!("{}", String::from_utf8_lossy(&o.stderr)));
-    let v: serde_json::Value = serde_json::from_str(line).unwrap();
+    let glb = out.join("mickey.glb");
+    let v = run_script("check_import.py", &["--glb", glb.to_str().unwrap()]);
     assert_eq!(v["fps"].as_f64().unwrap(), 60.0);
     assert_eq!(v["frame_t"].as_f64().unwrap(), 72.0);
     assert_eq!(v["frame_start"], 0);
@@ -66,6 +55,29 @@ fn import_keeps_animation_light_cameras_and_frame_range() {
     assert_eq!(v["lights"]["light"]["type"], "POINT");
     let light = &v["poses_at_t"]["light"]["location"];
     assert!((light[2].as_f64().unwrap() - 6.0).abs() < 1e-5, "{light}");
+    // Each occluder's launch arrives as custom properties (glTF node extras).
+    let solution: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("solution.json")).unwrap()).unwrap();
+    for o in solution["occluders"].as_array().unwrap() {
+        let name = o["name"].as_str().unwrap();
+        let props = &v["custom_properties"][name];
+        assert_eq!(props["scene"], "mickey", "{name}: {props}");
+        assert_eq!(props["launched"], o["launched"], "{name}: {props}");
+        assert!(props["mass_kg"].as_f64().unwrap() > 0.0, "{name}: {props}");
+        for (key, sol_key) in [
+            ("launch_velocity_m_s", "velocity_m_s"),
+            ("angular_velocity_rad_s", "angular_velocity_rad_s"),
+        ] {
+            for k in 0..3 {
+                let got = props[key][k].as_f64().unwrap();
+                let want = o[sol_key][k].as_f64().unwrap();
+                assert!(
+                    (got - want).abs() < 1e-9,
+                    "{name} {key}[{k}]: {got} vs {want}"
+                );
+            }
+        }
+    }
     // The animation plays: each occluder is where the solver put it at t.
     let p = Problem::new(bsa::scene::load(&root().join("scenes/mickey")).unwrap());
     let sol = bsa::output::files::read_solution(&out.join("solution.json")).unwrap();
@@ -113,4 +125,54 @@ fn video_of_mickey_renders_an_mp4() {
         "not an MP4 ({} bytes)",
         bytes.len()
     );
+}
+
+/// Run `blender/<script> -- <args>` with the bpy venv; its `BSA_RESULT` line as JSON.
+fn run_script(script: &str, args: &[&str]) -> serde_json::Value {
+    require(
+        &root().join(".venv-blender/bin/python"),
+        "bash blender/setup_venv.sh",
+    );
+    let o = Command::new(root().join(".venv-blender/bin/python"))
+        .arg(root().join("blender").join(script))
+        .arg("--")
+        .args(args)
+        .output()
+        .expect("the bpy virtualenv (bash blender/setup_venv.sh)");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let line = stdout
+        .lines()
+        .rev()
+        .find_map(|l| l.strip_prefix("BSA_RESULT "))
+        .unwrap_or_else(|| panic!("{}", String::from_utf8_lossy(&o.stderr)));
+    serde_json::from_str(line).unwrap()
+}
+
+#[test]
+#[ignore = "needs Blender's bpy in .venv-blender (bash blender/setup_venv.sh); run by scripts/test.sh"]
+fn glb_renders_the_picture_as_imported() {
+    // Default importer settings, the imported light and materials, Cycles from the shadow
+    // camera at t: the receiver is lit (not shadowed by the table top in its plane), the
+    // dark pixels are the target's, and the shadow is well contrasted.
+    let d = tmpdir("blender-render");
+    let out = d.join("out");
+    let (ok, _, err) = bsa(&["solve", "scenes/mickey", "--out", out.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let glb = out.join("mickey.glb");
+    let target = root().join("scenes/mickey/target.png");
+    let v = run_script(
+        "check_render.py",
+        &[
+            "--glb",
+            glb.to_str().unwrap(),
+            "--target",
+            target.to_str().unwrap(),
+        ],
+    );
+    eprintln!("{v}");
+    assert_eq!(v["black"], false, "the receiver renders black: {v}");
+    assert!(v["lit_mean"].as_f64().unwrap() > 0.3, "{v}");
+    assert!(v["iou"].as_f64().unwrap() >= 0.98, "{v}");
+    let ratio = v["lit_mean"].as_f64().unwrap() / v["shadow_mean"].as_f64().unwrap().max(1e-9);
+    assert!(ratio >= 4.0, "lit / shadow {ratio}: {v}");
 }

@@ -27,7 +27,7 @@ use json::validation::{Checked::Valid, USize64};
 use json::Index;
 
 use crate::geometry::shape::{Shape, TriMesh};
-use crate::output::trajectory::Track;
+use crate::output::trajectory::{LaunchRow, Track};
 use crate::scene::Scene;
 
 mod build;
@@ -42,9 +42,31 @@ pub use read::read_poses_at;
 pub const GENERATOR: &str = "ballistic-shadow-art";
 /// Name of the single animation.
 pub const ANIMATION_NAME: &str = "flight";
-/// Luminous intensity of the point light (cd). Only its presence and position matter for
-/// hard shadows; 1000 cd lights a receiver a few metres away well in a PBR viewer.
-pub const LIGHT_INTENSITY_CD: f64 = 1000.0;
+/// Illuminance (lux) that the point light gives at the picture's centre: `683 pi` lux,
+/// i.e. pi W/m^2 in Blender's 683 lm/W, so that the white diffuse receiver renders at
+/// scene-linear 1.0 there (well exposed under Blender's default AgX view transform; the
+/// same level as `blender/render_video.py`'s automatic energy). See [`light_intensity_cd`].
+pub const TARGET_ILLUMINANCE_LUX: f64 = 683.0 * std::f64::consts::PI;
+/// The table box is written this far (m) below its true place, along `-receiver.normal`,
+/// so that its top face, usually in the receiver's plane, does not shadow the receiver in
+/// a renderer (Cycles renders a coplanar table top as a black receiver). Bodies resting on
+/// the table at launch then float 2 mm above it; the receiver, and so the exact shadow
+/// geometry, is untouched.
+pub const TABLE_DROP_M: f64 = 0.002;
+
+/// Luminous intensity (cd) of the point light so that the illuminance at the receiver
+/// centre is [`TARGET_ILLUMINANCE_LUX`]: `E = I cos(theta) / r^2`, so `I = E r^3 / h`, with
+/// `r` the light's distance to the centre and `h` its height above the receiver plane
+/// (`r` if the light is not on the normal's side). 6 m straight above: about 77 000 cd,
+/// which Blender's importer turns into `cd 4 pi / 683` = 1421 W.
+pub fn light_intensity_cd(scene: &Scene) -> f64 {
+    let rc = &scene.receiver;
+    let d = scene.light - rc.center;
+    let r = d.length();
+    let h = d.dot(rc.normal);
+    let h = if h > 1e-9 * r { h } else { r };
+    TARGET_ILLUMINANCE_LUX * r * r * r / h
+}
 
 /// UV sphere resolution: segments around the polar axis and rings from pole to pole.
 /// 128 x 64 keeps the inscribed polyhedron's shadow within about a pixel of the exact
@@ -80,6 +102,9 @@ pub enum GltfError {
         expected: usize,
         got: usize,
     },
+    /// `write_glb_with_launches`: not one launch per occluder.
+    #[error("{got} launches for {expected} occluders")]
+    LaunchCount { expected: usize, got: usize },
     /// `write_glb`: a key time is negative, not finite, or not strictly after the previous
     /// one once stored as f32 (glTF stores times as f32; keys closer than its resolution
     /// would collapse).
@@ -130,7 +155,28 @@ pub enum GltfError {
 /// of those nodes is the pose at `t`, so that a viewer that ignores animations shows the
 /// picture.
 pub fn write_glb(scene: &Scene, traj: &Track) -> Result<Vec<u8>, GltfError> {
+    write_glb_with_launches(scene, traj, None)
+}
+
+/// As [`write_glb`], with each occluder's launch (`launches[i]` for occluder `i`, as
+/// written to launch.csv) in its node's `extras`, which Blender's importer turns into
+/// custom properties: `scene`, `launched`, `mass_kg`, `launch_velocity_m_s` and
+/// `angular_velocity_rad_s` (vectors in the project's Z-up world frame, which is also
+/// Blender's). Without launches the extras hold only `scene`.
+pub fn write_glb_with_launches(
+    scene: &Scene,
+    traj: &Track,
+    launches: Option<&[LaunchRow]>,
+) -> Result<Vec<u8>, GltfError> {
     check_input(scene, traj)?;
+    if let Some(l) = launches {
+        if l.len() != scene.occluders.len() {
+            return Err(GltfError::LaunchCount {
+                expected: scene.occluders.len(),
+                got: l.len(),
+            });
+        }
+    }
     let mut b = Builder::new();
 
     let mut scene_nodes = Vec::new();
@@ -154,7 +200,18 @@ pub fn write_glb(scene: &Scene, traj: &Track) -> Result<Vec<u8>, GltfError> {
         let material = b.material(&occ.name, occluder_colour(i), 0.5);
         let mesh = b.mesh(&occ.name, &data, material)?;
         let (o, q) = traj.poses[traj.t_index][i];
+        let extras = match launches.map(|l| &l[i]) {
+            Some(l) => serde_json::json!({
+                "scene": scene.name,
+                "launched": l.launched,
+                "mass_kg": l.mass_kg,
+                "launch_velocity_m_s": [l.vx_m_s, l.vy_m_s, l.vz_m_s],
+                "angular_velocity_rad_s": [l.wx_rad_s, l.wy_rad_s, l.wz_rad_s],
+            }),
+            None => serde_json::json!({ "scene": scene.name }),
+        };
         let node = b.root.push(json::Node {
+            extras: Some(serde_json::value::to_raw_value(&extras)?),
             mesh: Some(mesh),
             name: Some(occ.name.clone()),
             translation: Some(to_f32(pos_to_gltf(o))),
@@ -181,14 +238,14 @@ pub fn write_glb(scene: &Scene, traj: &Track) -> Result<Vec<u8>, GltfError> {
         ..Default::default()
     }));
 
-    // Table: the same white as the receiver, because its top face usually lies in the
-    // receiver plane and two coplanar surfaces of different colours flicker in viewers.
+    // Table: the same white as the receiver, lowered by TABLE_DROP_M so that its top face,
+    // usually in the receiver plane, neither shadows the receiver nor flickers with it.
     if let Some(table) = &scene.table {
         let mesh = b.mesh("table", &cuboid_mesh(table.half_extents), white)?;
         scene_nodes.push(b.root.push(json::Node {
             mesh: Some(mesh),
             name: Some("table".into()),
-            translation: Some(to_f32(pos_to_gltf(table.center))),
+            translation: Some(to_f32(pos_to_gltf(table.center - rc.normal * TABLE_DROP_M))),
             ..Default::default()
         }));
     }
@@ -200,7 +257,7 @@ pub fn write_glb(scene: &Scene, traj: &Track) -> Result<Vec<u8>, GltfError> {
             color: [1.0, 1.0, 1.0],
             extensions: None,
             extras: Default::default(),
-            intensity: LIGHT_INTENSITY_CD as f32,
+            intensity: light_intensity_cd(scene) as f32,
             name: Some("light".into()),
             range: None,
             spot: None,

@@ -240,7 +240,17 @@ fn node_names_light_and_cameras() {
 
     let node = |name: &str| d.nodes().find(|n| n.name() == Some(name)).unwrap();
     let light = node("light").light().unwrap();
-    assert_eq!(light.intensity(), LIGHT_INTENSITY_CD as f32);
+    assert_eq!(light.intensity(), light_intensity_cd(&scene) as f32);
+    // The illuminance at the receiver centre is the target: E = I cos / r^2.
+    let d = scene.light - scene.receiver.center;
+    let e = light.intensity() as f64 * d.dot(scene.receiver.normal) / d.length().powi(3);
+    assert!((e / TARGET_ILLUMINANCE_LUX - 1.0).abs() < 1e-6, "{e} lux");
+    // The table is lowered by TABLE_DROP_M: its top face is below the receiver plane.
+    let table = scene.table.as_ref().unwrap();
+    let (tt, _, _) = node("table").transform().decomposed();
+    let top = (pos_from_gltf(from_f32(tt)) - scene.receiver.center).dot(scene.receiver.normal)
+        + table.half_extents.z;
+    assert!((top + TABLE_DROP_M).abs() < 1e-6, "table top at {top} m");
     assert!(light.range().is_none());
     let (lt, _, _) = node("light").transform().decomposed();
     assert!(pos_from_gltf(from_f32(lt)).distance(scene.light) < 1e-6);
@@ -451,5 +461,22 @@ fn bad_input_is_reported() {
     assert!(matches!(
         read_poses_at(b"not a glb", 0.0),
         Err(GltfError::Parse(_))
+    ));
+}
+
+#[test]
+fn occluder_nodes_carry_extras_and_launches_must_match() {
+    let scene = mickey();
+    let traj = ballistic(&scene);
+    let d = doc(&write_glb(&scene, &traj).unwrap());
+    for occ in &scene.occluders {
+        let node = d.nodes().find(|n| n.name() == Some(&occ.name)).unwrap();
+        let extras: serde_json::Value =
+            serde_json::from_str(node.extras().as_ref().unwrap().get()).unwrap();
+        assert_eq!(extras["scene"], scene.name.as_str());
+    }
+    assert!(matches!(
+        write_glb_with_launches(&scene, &traj, Some(&[])),
+        Err(GltfError::LaunchCount { got: 0, .. })
     ));
 }
