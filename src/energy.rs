@@ -150,6 +150,28 @@ impl Weights {
         self.0[t as usize] != 0.0
     }
 
+    /// The weights of a stage whose scene file gives none: every pixel term in units of
+    /// the target's area (`target_pixels`), so that a total of 1 is a shadow as wrong as
+    /// the target is big, whatever the picture's size:
+    /// - XOR 1 and barrier 1 per target area;
+    /// - hints 0.3 per target area: a hint pulls a body by 0.3 of what a pixel of the
+    ///   picture is worth, enough to draw a body whose shadow is hidden (the picture
+    ///   does not change while it moves) and too little to outweigh the picture;
+    /// - regularization 0.01 per target area and m/s (or rad/s): a tie-breaker;
+    /// - contact 1e5 per target area and second: only used by the penalty mode
+    ///   (`"contacts": "penalty"`); the default constraint mode ranks contacts first
+    ///   whatever their weight.
+    pub fn default_for(target_pixels: f64) -> Weights {
+        let unit = 1.0 / target_pixels.max(1.0);
+        let mut w = [0.0; TERM_COUNT];
+        w[Term::Xor as usize] = unit;
+        w[Term::Barrier as usize] = unit;
+        w[Term::Hint as usize] = 0.3 * unit;
+        w[Term::Reg as usize] = 0.01 * unit;
+        w[Term::Contact as usize] = 1e5 * unit;
+        Weights(w)
+    }
+
     /// A weight vector with every term on (used by `bsa eval` to compute everything).
     pub fn all_ones() -> Weights {
         Weights([1.0; TERM_COUNT])
@@ -173,9 +195,27 @@ pub struct TargetData {
     pub moments: Moments,
     /// Shadow-free fallbacks: the image diagonal (pixels), used when a centroid is undefined.
     pub diagonal: f64,
-    /// Image centre (pixels) and barrier radius (half the image height, pixels).
+    /// Image centre (pixels) and barrier radius (pixels): half the image height, as in
+    /// the paper, or the distance from the centre to the farthest target pixel when the
+    /// target reaches beyond that circle (a barrier must not push a shadow off the
+    /// target's own corners).
     pub center: DVec2,
     pub barrier_radius: f64,
+}
+
+/// Distance (pixels) from `(cx, cy)` to the farthest corner of any set pixel of `mask`.
+fn farthest_pixel(mask: &Mask, cx: f64, cy: f64) -> f64 {
+    let mut far: f64 = 0.0;
+    for y in 0..mask.height() {
+        for x in 0..mask.width() {
+            if mask.get(x, y) {
+                let dx = (x as f64 + 0.5 - cx).abs() + 0.5;
+                let dy = (y as f64 + 0.5 - cy).abs() + 0.5;
+                far = far.max((dx * dx + dy * dy).sqrt());
+            }
+        }
+    }
+    far
 }
 
 impl TargetData {
@@ -190,7 +230,7 @@ impl TargetData {
             moments: mask.moments(),
             diagonal: (w * w + h * h).sqrt(),
             center: DVec2::new(w / 2.0, h / 2.0),
-            barrier_radius: h / 2.0,
+            barrier_radius: (h / 2.0).max(farthest_pixel(mask, w / 2.0, h / 2.0)),
         }
     }
 

@@ -52,6 +52,8 @@ pub(super) struct SolveProgress {
     quiet: bool,
     last_preview: Instant,
     stages_total: usize,
+    /// Iteration cap of one run of the current stage (a restart adds as many again).
+    run_length: u64,
 }
 
 impl SolveProgress {
@@ -68,6 +70,7 @@ impl SolveProgress {
             writer: Writer::start(out, scene.target.clone(), csv),
             stage_names: scene.stages.iter().map(|s| s.name.clone()).collect(),
             encoded: 0,
+            run_length: 0,
             bar: None,
             quiet,
             // In the past, so that the first iteration already writes a preview.
@@ -93,6 +96,7 @@ impl SolveProgress {
 
 impl Observer for SolveProgress {
     fn stage_started(&mut self, index: usize, stage: &Stage) {
+        self.run_length = stage.max_iterations as u64;
         let bar = bar(
             stage.max_iterations as u64,
             "{prefix} [{bar:30}] {pos}/{len} it {msg}",
@@ -105,6 +109,16 @@ impl Observer for SolveProgress {
             stage.name
         ));
         self.bar = Some(bar);
+    }
+
+    fn restarted(&mut self, _index: usize, restart: usize, population: usize) {
+        if let Some(bar) = &self.bar {
+            // Each restart runs up to the stage's iteration cap again.
+            bar.set_length(bar.length().unwrap_or(0) + self.run_length);
+            let prefix = bar.prefix();
+            let base = prefix.split(" (restart").next().unwrap_or(&prefix).to_string();
+            bar.set_prefix(format!("{base} (restart {restart}, population {population})"));
+        }
     }
 
     fn iteration(&mut self, info: &IterationInfo) {
@@ -133,8 +147,14 @@ impl Observer for SolveProgress {
         // stay on stderr).
         if let Some(r) = s.stages.last() {
             println!(
-                "stage {}/{} `{}`: {} iterations, {} samples, best energy {:.4e}, IoU {:.4}, {:.2} s ({})",
-                s.stages_completed, s.stages_total, r.name, r.iterations, r.samples, r.best_energy, r.iou, r.wall_time_s, r.stop
+                "stage {}/{} `{}`: {} iterations, {} samples{}, best energy {:.4e}, IoU {:.4}, {:.2} s ({})",
+                s.stages_completed, s.stages_total, r.name, r.iterations, r.samples,
+                match r.restarts {
+                    0 => String::new(),
+                    1 => ", 1 restart".to_string(),
+                    n => format!(", {n} restarts"),
+                },
+                r.best_energy, r.iou, r.wall_time_s, r.stop
             );
         }
         // `records` is every record of this run so far: only the new ones are handed over.

@@ -220,18 +220,17 @@ impl Layout {
 }
 
 /// The strategy a designed scene gets: one object at a time, then all together (for
-/// more than four objects, the pass one at a time runs twice).
+/// more than four objects, the pass one at a time runs twice), with the default weights
+/// ([`Weights::default_for`]) and contacts as constraints.
 pub fn default_strategy(objects: usize) -> Value {
-    let weights =
-        json!({"xor": 1.0, "hint": 0.3, "barrier": 1.0, "contact": 100000.0, "reg": 0.01});
     if objects <= 4 {
         return json!({"kind": "sequential", "order": "auto", "rounds": 1,
-            "stage": {"weights": weights, "step": 0.1, "population": 24, "max_iterations": 100, "stagnation": 30},
-            "final": {"weights": weights, "step": 0.05, "population": 32, "max_iterations": 150, "stagnation": 40}});
+            "stage": {"step": 0.1, "population": 24, "max_iterations": 100, "stagnation": 30},
+            "final": {"step": 0.05, "population": 32, "max_iterations": 150, "stagnation": 40}});
     }
     json!({"kind": "sequential", "order": "auto", "rounds": 2,
-        "stage": {"weights": weights, "step": 0.05, "population": 24, "max_iterations": 100, "stagnation": 25},
-        "final": {"weights": weights, "step": 0.02, "population": 32, "max_iterations": 100, "stagnation": 25}})
+        "stage": {"step": 0.05, "population": 24, "max_iterations": 100, "stagnation": 25},
+        "final": {"step": 0.02, "population": 32, "max_iterations": 100, "stagnation": 25}})
 }
 
 /// Draw launches for every launched occluder of `problem` until one flies clear of
@@ -302,13 +301,16 @@ pub fn draw_launch(problem: &Problem, seed: u64, attempts: usize) -> Result<Vec<
 
 /// One hint per object from the target alone, as a user would place them: the target's
 /// blobs (4-connected) and the objects are each sorted by size (blob area, object
-/// volume), and each object in turn takes the blob with the most area per object already
-/// on it; its hint sends its centre to that blob's centroid.
+/// volume); while some blob has no object, the largest object left takes the largest
+/// blob left, so that every blob is covered; the objects beyond take, in turn, the
+/// blob with the most area per object already on it. A hint sends the object's centre
+/// to its blob's centroid.
 pub fn hints(problem: &Problem, target: &Mask) -> Vec<(usize, DVec2)> {
-    let blobs = blobs(target);
+    let mut blobs = target.blobs();
     if blobs.is_empty() {
         return Vec::new();
     }
+    blobs.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.x.total_cmp(&b.1.x)));
     let occ = &problem.scene.occluders;
     let mut order: Vec<usize> = (0..occ.len()).filter(|&i| occ[i].launched).collect();
     order.sort_by(|&a, &b| {
@@ -320,53 +322,20 @@ pub fn hints(problem: &Problem, target: &Mask) -> Vec<(usize, DVec2)> {
     });
     let mut taken = vec![0usize; blobs.len()];
     let mut out = Vec::new();
-    for i in order {
-        let k = (0..blobs.len())
-            .max_by(|&a, &b| {
-                let share = |k: usize| blobs[k].0 as f64 / (1 + taken[k]) as f64;
-                share(a).total_cmp(&share(b)).then(b.cmp(&a))
-            })
-            .expect("at least one blob");
+    for (rank, i) in order.into_iter().enumerate() {
+        let k = if rank < blobs.len() {
+            rank
+        } else {
+            (0..blobs.len())
+                .max_by(|&a, &b| {
+                    let share = |k: usize| blobs[k].0 as f64 / (1 + taken[k]) as f64;
+                    share(a).total_cmp(&share(b)).then(b.cmp(&a))
+                })
+                .expect("at least one blob")
+        };
         taken[k] += 1;
         out.push((i, blobs[k].1));
     }
     out.sort_by_key(|h| h.0);
-    out
-}
-
-/// The 4-connected components of a mask: (pixel count, centroid in pixel coordinates).
-fn blobs(mask: &Mask) -> Vec<(usize, DVec2)> {
-    let (w, h) = (mask.width(), mask.height());
-    let mut label = vec![usize::MAX; w * h];
-    let mut out = Vec::new();
-    let mut stack = Vec::new();
-    for y0 in 0..h {
-        for x0 in 0..w {
-            if !mask.get(x0, y0) || label[y0 * w + x0] != usize::MAX {
-                continue;
-            }
-            let id = out.len();
-            let (mut count, mut sum) = (0usize, DVec2::ZERO);
-            label[y0 * w + x0] = id;
-            stack.push((x0, y0));
-            while let Some((x, y)) = stack.pop() {
-                count += 1;
-                sum += DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
-                let near = [
-                    (x.wrapping_sub(1), y),
-                    (x + 1, y),
-                    (x, y.wrapping_sub(1)),
-                    (x, y + 1),
-                ];
-                for (nx, ny) in near {
-                    if nx < w && ny < h && mask.get(nx, ny) && label[ny * w + nx] == usize::MAX {
-                        label[ny * w + nx] = id;
-                        stack.push((nx, ny));
-                    }
-                }
-            }
-            out.push((count, sum / count as f64));
-        }
-    }
     out
 }

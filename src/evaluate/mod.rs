@@ -81,6 +81,9 @@ pub struct Workspace {
     table_hit: Vec<Option<f64>>,
     /// Times of the pair contacts found in the last sample (room for every pair).
     pair_hits: Vec<f64>,
+    /// Whether each pair contact searched in the last sample (after the held ones in
+    /// `pair_hits`) counts in [`Outcome::own_contact`].
+    pair_counts: Vec<bool>,
 }
 
 impl Workspace {
@@ -100,6 +103,11 @@ pub struct Outcome {
     pub n_contacts: u32,
     /// The first contact's participants: (occluder, other occluder or `None` for the table).
     pub first_contact: Option<(usize, Option<usize>)>,
+    /// The contact time `(t - t_first) n` of the contacts that involve a body the
+    /// evaluation varies (all of them outside a stage): a stage ranks its samples by
+    /// what it can change, so that a contact between two held bodies does not make every
+    /// sample equally infeasible. 0 without such a contact.
+    pub own_contact: f64,
 }
 
 /// The energy of one sample.
@@ -115,7 +123,8 @@ pub struct Evaluation {
 }
 
 impl Evaluation {
-    fn diverged() -> Evaluation {
+    /// The evaluation of a sample that diverged (or of none yet): it ranks last.
+    pub fn diverged() -> Evaluation {
         Evaluation {
             raw: [f64::NAN; TERM_COUNT],
             total: DIVERGED_ENERGY,
@@ -123,6 +132,7 @@ impl Evaluation {
                 t_sim: 0.0,
                 n_contacts: 0,
                 first_contact: None,
+                own_contact: 0.0,
             },
             iou: 0.0,
         }
@@ -157,12 +167,27 @@ pub struct Held {
     pair_hits: Vec<(f64, usize, usize, usize)>,
     /// The held occluders' shadow at `t`.
     mask: Mask,
+    /// Held occluders whose contacts with the varying ones do not count in
+    /// [`Outcome::own_contact`]: bodies still at their start guess, which a later stage
+    /// will move anyway (see [`Held::ignore_contacts_with`]).
+    ignored: Vec<bool>,
 }
 
 impl Held {
     /// The launch values of every occluder that the held ones keep (6 per occluder).
     pub fn base(&self) -> &[f64] {
         &self.base
+    }
+
+    /// Let the stage's ranking ignore contacts between a varying body and the held
+    /// occluders `i` with `unplaced[i]`: the first pass of the sequential strategy places
+    /// one body at a time, and a body still at its start guess is not an obstacle the
+    /// body being placed must go around. The contacts still count in the outcome's
+    /// `t_sim` and `n_contacts` (the reports), and varying occluders are never ignored.
+    pub fn ignore_contacts_with(&mut self, unplaced: &[bool]) {
+        for (i, flag) in self.ignored.iter_mut().enumerate() {
+            *flag = unplaced[i] && !self.varying[i];
+        }
     }
 }
 
@@ -188,6 +213,7 @@ impl Problem {
             table_hit: vec![None; n],
             pair_hits: Vec::new(),
             mask: ws.mask.clone(),
+            ignored: vec![false; n],
         };
         if base.iter().any(|x| !x.is_finite()) || self.spins_too_fast(base) {
             return held;
@@ -277,6 +303,7 @@ impl Problem {
             landing: vec![None; n],
             table_hit: vec![None; n],
             pair_hits: Vec::with_capacity(n * n.saturating_sub(1) / 2),
+            pair_counts: Vec::with_capacity(n * n.saturating_sub(1) / 2),
         }
     }
 
@@ -427,7 +454,11 @@ impl Problem {
         let scene = &self.scene;
         let t = scene.t;
         let n = scene.occluders.len();
+        let varies = |i: usize| held.is_none_or(|h| h.varying[i]);
+        let ignored = |i: usize| held.is_some_and(|h| h.ignored[i]);
+        // The first contact of all, and the first that involves a varying body.
         let mut best = (f64::INFINITY, usize::MAX);
+        let mut own = f64::INFINITY;
         let mut first = None;
         // Landings are needed for every body (they decide its pose at t), so they are
         // searched over the whole flight.
@@ -442,6 +473,9 @@ impl Problem {
                     best = (time, i);
                     first = Some((i, None));
                 }
+                if varies(i) {
+                    own = own.min(time);
+                }
             }
         }
         ws.pair_hits.clear();
@@ -454,22 +488,30 @@ impl Problem {
                 }
             }
         }
+        let held_pairs = ws.pair_hits.len();
+        ws.pair_counts.clear();
         let mut key = n;
         for i in 0..n {
             for j in (i + 1)..n {
                 key += 1;
                 if !scene.occluders[i].launched && !scene.occluders[j].launched
-                    || held.is_some_and(|h| !h.varying[i] && !h.varying[j])
+                    || !varies(i) && !varies(j)
                 {
                     continue;
                 }
-                let horizon = t.min(best.0 + SIMULTANEOUS);
+                // Every pair searched here involves a varying body: it is searched up
+                // to the first such contact, which finds the first contact of all too.
+                let horizon = t.min(own + SIMULTANEOUS);
                 let flights_of = |k: usize| match held {
                     Some(h) if !h.varying[k] => &h.flights[..],
                     _ => &ws.flights[..],
                 };
                 if let Some(tc) = self.pair_contact(i, flights_of(i), j, flights_of(j), horizon) {
                     ws.pair_hits.push(tc);
+                    ws.pair_counts.push(!ignored(i) && !ignored(j));
+                    if !ignored(i) && !ignored(j) {
+                        own = own.min(tc);
+                    }
                     if (tc, key - 1) < best {
                         best = (tc, key - 1);
                         first = Some((i, Some(j)));
@@ -477,12 +519,27 @@ impl Problem {
                 }
             }
         }
+        let own_contact = if own < t {
+            let cut = own + SIMULTANEOUS;
+            let count = (0..n)
+                .filter(|&i| varies(i) && ws.table_hit[i].is_some_and(|tl| tl <= cut))
+                .count()
+                + ws.pair_hits[held_pairs..]
+                    .iter()
+                    .zip(&ws.pair_counts)
+                    .filter(|&(&tc, &counts)| counts && tc <= cut)
+                    .count();
+            (t - own) * count.max(1) as f64
+        } else {
+            0.0
+        };
         let best = best.0;
         if best >= t {
             return Outcome {
                 t_sim: t,
                 n_contacts: 0,
                 first_contact: None,
+                own_contact,
             };
         }
         let cut = best + SIMULTANEOUS;
@@ -497,6 +554,7 @@ impl Problem {
             t_sim: best,
             n_contacts: (count as u32).max(1),
             first_contact: first,
+            own_contact,
         }
     }
 

@@ -27,9 +27,10 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::energy::DIVERGED_ENERGY;
-use crate::energy::{Term, Weights, TERM_COUNT};
+use crate::energy::{Term, Weights};
 use crate::evaluate::{Evaluation, Held, Problem, Workspace};
 use crate::optimize::cmaes::{Cmaes, CmaesConfig, StopReason};
+use crate::optimize::moves;
 use crate::output::solution::{OccluderLaunch, SampleRecord, Solution, StageReport, TermValue};
 use crate::scene::{Contacts, Launch, Stage};
 use crate::shadow::mask::Mask;
@@ -51,7 +52,11 @@ pub struct SolveOptions {
 pub struct IterationInfo<'a> {
     pub stage_index: usize,
     pub stage: &'a Stage,
+    /// Iterations of the stage so far, over all its runs.
     pub iteration: usize,
+    /// Restarts of the stage so far (0 during its first run).
+    pub restart: usize,
+    /// Samples of the stage so far, over all its runs.
     pub samples: usize,
     /// Best total energy of the stage so far.
     pub best_energy: f64,
@@ -67,6 +72,9 @@ pub struct IterationInfo<'a> {
 pub trait Observer {
     fn stage_started(&mut self, _index: usize, _stage: &Stage) {}
     fn iteration(&mut self, _info: &IterationInfo) {}
+    /// Stage `index` starts its restart number `restart` with `population` samples per
+    /// iteration.
+    fn restarted(&mut self, _index: usize, _restart: usize, _population: usize) {}
     /// Called after each stage with the solution so far (save it: nothing is lost).
     fn stage_finished(&mut self, _solution: &Solution, _records: &[SampleRecord]) {}
 }
@@ -123,18 +131,22 @@ impl Pool {
 }
 
 /// Samples with a contact rank above this under [`Contacts::Constraint`]: above every
-/// real energy, far below [`DIVERGED_ENERGY`], and small enough that a microsecond of
-/// contact time still changes the rank (f64 resolves 1e-4 at 1e12).
+/// real energy and far below [`DIVERGED_ENERGY`].
 const INFEASIBLE: f64 = 1e12;
 
 /// The value CMA-ES ranks a sample by. Under [`Contacts::Constraint`] a sample with a
-/// contact before `t` ranks after every sample without one, by its contact time
-/// (`(t - t_sim) n`, the raw contact term), so that the contact weight does not matter;
-/// under [`Contacts::Penalty`] it is the weighted energy, as in the paper.
+/// contact before `t` that involves a body the stage varies ranks after every sample
+/// without one, by its contact time (`(t - t_first) n`, [`Outcome::own_contact`]) and
+/// then by its energy: `INFEASIBLE (1 + contact time) + energy`, where a microsecond of
+/// contact time (1e6) outweighs any energy below 1e5 (the energy is capped there, so
+/// the order is lexicographic). Under [`Contacts::Penalty`] it is the weighted energy,
+/// as in the paper.
+///
+/// [`Outcome::own_contact`]: crate::evaluate::Outcome::own_contact
 fn rank_value(e: &Evaluation, contacts: Contacts) -> f64 {
     match contacts {
-        Contacts::Constraint if e.outcome.n_contacts > 0 && e.total < DIVERGED_ENERGY => {
-            INFEASIBLE + 1e6 * e.raw[Term::Contact as usize]
+        Contacts::Constraint if e.outcome.own_contact > 0.0 && e.total < DIVERGED_ENERGY => {
+            INFEASIBLE * (1.0 + e.outcome.own_contact) + e.total.min(1e5)
         }
         _ => e.total,
     }
@@ -156,6 +168,16 @@ fn stage_seed(seed: u64, k: usize) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^ (z >> 31)
+}
+
+/// Seed of a stage's CMA-ES run: the first run of stage `k` keeps [`stage_seed`], so
+/// that a stage without restarts draws what it always drew; each restart draws its own.
+fn restart_seed(seed: u64, k: usize, restart: usize) -> u64 {
+    if restart == 0 {
+        stage_seed(seed, k)
+    } else {
+        stage_seed(stage_seed(seed, k) ^ restart as u64, restart)
+    }
 }
 
 fn stop_name(s: Option<StopReason>, interrupted: bool, stopped: bool) -> String {
@@ -210,6 +232,14 @@ pub fn solve(
         None => (scene.start_parameters(), 0, Vec::new(), Vec::new(), 0.0),
     };
     let mut aborted = false;
+    // Occluders that no stage has varied yet (a resumed solve has varied those of its
+    // completed stages).
+    let mut unplaced = vec![true; scene.occluders.len()];
+    for stage in &scene.stages[..first_stage.min(scene.stages.len())] {
+        for &i in &stage.vary {
+            unplaced[i] = false;
+        }
+    }
 
     for (k, stage) in scene.stages.iter().enumerate().skip(first_stage) {
         if interrupts.load(Ordering::SeqCst) >= 2 {
@@ -221,35 +251,16 @@ pub fn solve(
         let interrupts_at_start = interrupts.load(Ordering::SeqCst);
         let n = Launch::LEN * stage.vary.len();
         let mut x0 = vec![0.0; n];
-        for (j, &i) in stage.vary.iter().enumerate() {
-            Launch::copy(&params, i, &mut x0, j);
-        }
-        let config = CmaesConfig {
-            population: Some(stage.population),
-            max_generations: stage.max_iterations,
-            f_target: stage.target_energy,
-            tol_fun: stage.tol_fun,
-            stagnation_window: stage.stagnation,
-            ..CmaesConfig::default()
-        };
-        let mut cma = Cmaes::new(&x0, stage.step, config, stage_seed(seed, k));
-        let lambda = cma.population();
-        let mut evals = vec![
-            Evaluation {
-                raw: [0.0; TERM_COUNT],
-                total: 0.0,
-                outcome: crate::evaluate::Outcome {
-                    t_sim: 0.0,
-                    n_contacts: 0,
-                    first_contact: None
-                },
-                iou: 0.0
-            };
-            lambda
-        ];
-        let mut fitness = vec![0.0; lambda];
+        let mut evals: Vec<Evaluation> = Vec::new();
+        let mut fitness: Vec<f64> = Vec::new();
         // What the stage holds fixed, computed once: a sample only pays for what varies.
-        let held = problem.hold(&params, &stage.vary);
+        let mut held = problem.hold(&params, &stage.vary);
+        // Bodies no stage has moved yet are still at their start guess: the body being
+        // placed need not go around them (they will move), only around those placed.
+        held.ignore_contacts_with(&unplaced);
+        for &i in &stage.vary {
+            unplaced[i] = false;
+        }
         // The stage's own record of its best: the stage starts from the previous best,
         // which it must never end worse than.
         let mut best_params = params.clone();
@@ -258,57 +269,117 @@ pub fn solve(
         let start_eval = best_eval;
         let mut best_mask = ws.mask.clone();
         let mut iteration = 0;
+        let mut samples = 0;
         let mut interrupted = false;
         let mut scratch = vec![0.0; params.len()];
-        let mut candidates = vec![0.0; lambda * n];
+        let mut candidates: Vec<f64> = Vec::new();
+        let mut restart = 0;
+        let (mut lambda, mut population) = (0, stage.population);
         let stop = loop {
-            if interrupts.load(Ordering::SeqCst) > interrupts_at_start {
-                interrupted = true;
-                break None;
-            }
-            candidates.copy_from_slice(cma.ask());
-            pool.evaluate(problem, &held, stage, &candidates, n, &mut evals);
-            let mut improved = None;
-            for (j, e) in evals.iter().enumerate() {
-                fitness[j] = rank_value(e, scene.contacts);
-                records.push(SampleRecord {
-                    stage: k,
-                    iteration,
-                    terms: e.weighted(&stage.weights),
-                    total: e.total,
-                });
-                if rank_value(e, scene.contacts) < rank_value(&best_eval, scene.contacts) {
-                    best_eval = *e;
-                    improved = Some(j);
-                }
-            }
-            if let Some(j) = improved {
-                problem.expand(
-                    &params,
-                    &stage.vary,
-                    &candidates[j * n..(j + 1) * n],
-                    &mut scratch,
-                );
-                best_params.copy_from_slice(&scratch);
-                problem.evaluate_held(&held, &best_params, &stage.weights, &mut ws);
+            // One CMA-ES run from the stage's best so far: the first with the stage's
+            // population, each restart (IPOP) with twice the previous one and the
+            // stage's initial step, so that it searches wider than the run that stalled.
+            // Before each run, moves send the stage's bodies where CMA-ES's local steps
+            // would not (see `moves`); a run may start from a better picture with a
+            // contact, which only replaces the best once its contact is gone.
+            let rank = |e: &Evaluation| rank_value(e, scene.contacts);
+            let moved = moves::improve(
+                problem,
+                &held,
+                &stage.vary,
+                &stage.weights,
+                &rank,
+                &mut best_params,
+                &mut best_eval,
+                stage.vary.len(),
+                &mut ws,
+            );
+            samples += moved.samples;
+            if moved.accepted > 0 {
                 best_mask.copy_from(&ws.mask);
             }
-            cma.tell(&fitness);
-            iteration += 1;
-            let elapsed = stage_start.elapsed().as_secs_f64();
-            observer.iteration(&IterationInfo {
-                stage_index: k,
-                stage,
-                iteration,
-                samples: cma.evaluations(),
-                best_energy: best_eval.total,
-                best_iou: best_eval.iou,
-                samples_per_second: cma.evaluations() as f64 / elapsed.max(1e-9),
-                best_shadow: &best_mask,
-            });
-            if let Some(s) = cma.stop() {
-                break Some(s);
+            let start_from = moved.promising;
+            let from = start_from.as_deref().unwrap_or(&best_params);
+            for (j, &i) in stage.vary.iter().enumerate() {
+                Launch::copy(from, i, &mut x0, j);
             }
+            let config = CmaesConfig {
+                population: Some(population),
+                max_generations: stage.max_iterations,
+                f_target: stage.target_energy,
+                tol_fun: stage.tol_fun,
+                stagnation_window: stage.stagnation,
+                ..CmaesConfig::default()
+            };
+            let mut cma = Cmaes::new(&x0, stage.step, config, restart_seed(seed, k, restart));
+            if restart == 0 {
+                lambda = cma.population();
+            }
+            let pop = cma.population();
+            evals.resize(pop, Evaluation::diverged());
+            fitness.resize(pop, 0.0);
+            candidates.resize(pop * n, 0.0);
+            let stop = loop {
+                if interrupts.load(Ordering::SeqCst) > interrupts_at_start {
+                    interrupted = true;
+                    break None;
+                }
+                candidates.copy_from_slice(cma.ask());
+                pool.evaluate(problem, &held, stage, &candidates, n, &mut evals);
+                let mut improved = None;
+                for (j, e) in evals.iter().enumerate() {
+                    fitness[j] = rank_value(e, scene.contacts);
+                    records.push(SampleRecord {
+                        stage: k,
+                        iteration,
+                        terms: e.weighted(&stage.weights),
+                        total: e.total,
+                    });
+                    if fitness[j] < rank_value(&best_eval, scene.contacts) {
+                        best_eval = *e;
+                        improved = Some(j);
+                    }
+                }
+                if let Some(j) = improved {
+                    problem.expand(
+                        &params,
+                        &stage.vary,
+                        &candidates[j * n..(j + 1) * n],
+                        &mut scratch,
+                    );
+                    best_params.copy_from_slice(&scratch);
+                    problem.evaluate_held(&held, &best_params, &stage.weights, &mut ws);
+                    best_mask.copy_from(&ws.mask);
+                }
+                cma.tell(&fitness);
+                iteration += 1;
+                samples += pop;
+                let elapsed = stage_start.elapsed().as_secs_f64();
+                observer.iteration(&IterationInfo {
+                    stage_index: k,
+                    stage,
+                    iteration,
+                    restart,
+                    samples,
+                    best_energy: best_eval.total,
+                    best_iou: best_eval.iou,
+                    samples_per_second: samples as f64 / elapsed.max(1e-9),
+                    best_shadow: &best_mask,
+                });
+                if let Some(s) = cma.stop() {
+                    break Some(s);
+                }
+            };
+            let restartable = !interrupted
+                && stop != Some(StopReason::TargetReached)
+                && restart < stage.restarts
+                && best_eval.iou < stage.restart_iou;
+            if !restartable {
+                break stop;
+            }
+            restart += 1;
+            population = 2 * pop;
+            observer.restarted(k, restart, population);
         };
         // The last stage never leaves a worse picture than it started from: a joint stage
         // can lower its total energy (hints, regularization) while the shadow gets worse.
@@ -331,8 +402,9 @@ pub fn solve(
         reports.push(StageReport {
             name: stage.name.clone(),
             iterations: iteration,
-            samples: cma.evaluations(),
+            samples,
             population: lambda,
+            restarts: restart,
             best_energy: best_eval.total,
             iou: best_eval.iou,
             stop: stop_text,

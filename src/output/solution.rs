@@ -49,7 +49,11 @@ pub struct StageReport {
     pub name: String,
     pub iterations: usize,
     pub samples: usize,
+    /// Population of the stage's first run (restarts double it each time).
     pub population: usize,
+    /// Restarts the stage made (IPOP); absent in files written before restarts existed.
+    #[serde(default)]
+    pub restarts: usize,
     pub best_energy: f64,
     pub iou: f64,
     pub stop: String,

@@ -164,6 +164,12 @@ pub struct Stage {
     pub tol_fun: f64,
     /// Stop after this many iterations without improvement.
     pub stagnation: usize,
+    /// Restarts (IPOP: from the best so far, with the initial step and twice the
+    /// previous population) allowed when the stage stops with its picture below
+    /// `restart_iou`.
+    pub restarts: usize,
+    /// IoU at `t` from which a stage no longer restarts (0 to 1).
+    pub restart_iou: f64,
 }
 
 /// Which strategy produced the stage list (kept for reports).
@@ -283,6 +289,13 @@ pub const MAX_ITERATIONS: usize = 1_000_000;
 /// Largest stagnation window (iterations) of a stage; the solver keeps a history this
 /// long.
 pub const MAX_STAGNATION: usize = 100_000;
+/// Restarts a stage may make when its file does not say (see [`Stage::restarts`]).
+pub const DEFAULT_RESTARTS: usize = 2;
+/// Most restarts of one stage: the population doubles at each, so 10 is a thousand
+/// times the first population.
+pub const MAX_RESTARTS: usize = 10;
+/// IoU from which a stage no longer restarts when its file does not say.
+pub const DEFAULT_RESTART_IOU: f64 = 0.995;
 /// Most stages a scene may expand to (scheduled list, or rounds times the order).
 pub const MAX_STAGES: usize = 10_000;
 /// Most triangles of one OBJ mesh after triangulation; larger meshes are refused with a

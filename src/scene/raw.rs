@@ -93,7 +93,7 @@ pub(super) struct RawStart {
 #[serde(deny_unknown_fields)]
 pub(super) struct RawStage {
     pub(super) name: Option<String>,
-    pub(super) weights: HashMap<String, f64>,
+    pub(super) weights: Option<HashMap<String, f64>>,
     pub(super) vary: Option<RawVary>,
     pub(super) step: Option<f64>,
     pub(super) max_iterations: Option<usize>,
@@ -101,6 +101,8 @@ pub(super) struct RawStage {
     pub(super) target_energy: Option<f64>,
     pub(super) tol_fun: Option<f64>,
     pub(super) stagnation: Option<usize>,
+    pub(super) restarts: Option<usize>,
+    pub(super) restart_iou: Option<f64>,
 }
 
 #[derive(Deserialize, Clone)]

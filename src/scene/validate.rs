@@ -187,10 +187,11 @@ impl Validator<'_> {
             }
         }
         self.check_start_guess(&occluders)?;
-        let (stages, strategy) = self.stages(&raw, &occluders)?;
+        let defaults = Weights::default_for(target.count() as f64);
+        let (stages, strategy) = self.stages(&raw, &occluders, defaults)?;
         let contacts = match raw.contacts.as_deref() {
-            Some("constraint") => Contacts::Constraint,
-            None | Some("penalty") => Contacts::Penalty,
+            None | Some("constraint") => Contacts::Constraint,
+            Some("penalty") => Contacts::Penalty,
             Some(other) => {
                 return Err(self.field_err(
                     "contacts",
@@ -566,9 +567,13 @@ impl Validator<'_> {
         default_name: String,
         default_vary: &[usize],
         occ: &[Occluder],
+        defaults: StageDefaults,
     ) -> Result<Stage> {
         let mut w = [0.0; TERM_COUNT];
-        for (key, value) in &rs.weights {
+        if rs.weights.is_none() {
+            w = defaults.weights.0;
+        }
+        for (key, value) in rs.weights.iter().flatten() {
             let term = Term::from_key(key).ok_or_else(|| {
                 self.field_err(
                     format!("{field}.weights.{key}"),
@@ -651,6 +656,20 @@ impl Validator<'_> {
                 format!("must be between 1 and {MAX_STAGNATION} iterations, got {stagnation}"),
             ));
         }
+        let restarts = rs.restarts.unwrap_or(defaults.restarts);
+        if restarts > MAX_RESTARTS {
+            return Err(self.field_err(
+                format!("{field}.restarts"),
+                format!("must be between 0 and {MAX_RESTARTS}, got {restarts}"),
+            ));
+        }
+        let restart_iou = rs.restart_iou.unwrap_or(DEFAULT_RESTART_IOU);
+        if !(0.0..=1.0).contains(&restart_iou) {
+            return Err(self.field_err(
+                format!("{field}.restart_iou"),
+                format!("must be an IoU between 0 and 1, got {restart_iou}"),
+            ));
+        }
         Ok(Stage {
             name: rs.name.clone().unwrap_or(default_name),
             weights: Weights(w),
@@ -661,10 +680,17 @@ impl Validator<'_> {
             target_energy,
             tol_fun,
             stagnation,
+            restarts,
+            restart_iou,
         })
     }
 
-    fn stages(&self, raw: &RawScene, occ: &[Occluder]) -> Result<(Vec<Stage>, Strategy)> {
+    fn stages(
+        &self,
+        raw: &RawScene,
+        occ: &[Occluder],
+        defaults: Weights,
+    ) -> Result<(Vec<Stage>, Strategy)> {
         let launched: Vec<usize> = occ
             .iter()
             .enumerate()
@@ -679,7 +705,10 @@ impl Validator<'_> {
                 let stages = list
                     .iter()
                     .enumerate()
-                    .map(|(i, s)| self.stage(&format!("stages[{i}]"), s, format!("stage {}", i + 1), &launched, occ))
+                    .map(|(i, s)| {
+                        let d = StageDefaults::of(defaults, i + 1 == list.len());
+                        self.stage(&format!("stages[{i}]"), s, format!("stage {}", i + 1), &launched, occ, d)
+                    })
                     .collect::<Result<Vec<_>>>()?;
                 Ok((stages, Strategy::Scheduled))
             }
@@ -734,15 +763,35 @@ impl Validator<'_> {
                         } else {
                             format!("{} ({round})", occ[i].name)
                         };
-                        let s = self.stage("strategy.stage", stage, name, &[i], occ)?;
+                        let d = StageDefaults::of(defaults, false);
+                        let s = self.stage("strategy.stage", stage, name, &[i], occ, d)?;
                         stages.push(s);
                     }
                 }
                 if let Some(fs) = final_stage {
-                    stages.push(self.stage("strategy.final", fs, "final".to_string(), &launched, occ)?);
+                    let d = StageDefaults::of(defaults, true);
+                    stages.push(self.stage("strategy.final", fs, "final".to_string(), &launched, occ, d)?);
                 }
                 Ok((stages, Strategy::Sequential { order }))
             }
+        }
+    }
+}
+
+/// What a stage gets for the fields its file leaves out, beyond the fixed defaults.
+#[derive(Clone, Copy)]
+struct StageDefaults {
+    weights: Weights,
+    restarts: usize,
+}
+
+impl StageDefaults {
+    /// The defaults of a stage: the scene's default weights, and restarts for the last
+    /// stage only (the one that varies every body and leaves the result).
+    fn of(weights: Weights, last: bool) -> StageDefaults {
+        StageDefaults {
+            weights,
+            restarts: if last { DEFAULT_RESTARTS } else { 0 },
         }
     }
 }

@@ -121,6 +121,43 @@ impl Mask {
         }
     }
 
+    /// The 4-connected components of the set pixels, in scan order of their first pixel:
+    /// (pixel count, centroid in pixel coordinates, pixel centres at `+0.5`).
+    pub fn blobs(&self) -> Vec<(usize, DVec2)> {
+        let (w, h) = (self.width, self.height);
+        let mut label = vec![false; w * h];
+        let mut out = Vec::new();
+        let mut stack = Vec::new();
+        for y0 in 0..h {
+            for x0 in 0..w {
+                if !self.get(x0, y0) || label[y0 * w + x0] {
+                    continue;
+                }
+                let (mut count, mut sum) = (0usize, DVec2::ZERO);
+                label[y0 * w + x0] = true;
+                stack.push((x0, y0));
+                while let Some((x, y)) = stack.pop() {
+                    count += 1;
+                    sum += DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+                    let near = [
+                        (x.wrapping_sub(1), y),
+                        (x + 1, y),
+                        (x, y.wrapping_sub(1)),
+                        (x, y + 1),
+                    ];
+                    for (nx, ny) in near {
+                        if nx < w && ny < h && self.get(nx, ny) && !label[ny * w + nx] {
+                            label[ny * w + nx] = true;
+                            stack.push((nx, ny));
+                        }
+                    }
+                }
+                out.push((count, sum / count as f64));
+            }
+        }
+        out
+    }
+
     /// A mask with pixel `(x, y)` set iff `f(x, y)`.
     pub fn from_fn(width: usize, height: usize, mut f: impl FnMut(usize, usize) -> bool) -> Mask {
         let mut m = Mask::new(width, height);

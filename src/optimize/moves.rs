@@ -1,0 +1,239 @@
+//! Assignment moves: the global jumps that CMA-ES does not make.
+//!
+//! A joint stage refines launches locally; it does not send a body across the picture.
+//! Two failures follow on problems that have a perfect answer: two bodies each cover the
+//! other's part (a large sphere lowered onto a small blob while the small sphere sits
+//! high on the large one), and a body hidden under another's shadow while a part of the
+//! target stays bare (the image energy does not change while it moves under the other
+//! shadow, so nothing draws it out). [`improve`] tries, from the best launch so far:
+//! - **swap** bodies `i` and `j`: each is sent to the other's line of sight from the
+//!   light, at the depth where its own shadow has the other's area, so that the picture
+//!   is unchanged up to the two shapes;
+//! - **fill** the largest bare part of the target with body `i`: sent to the line of
+//!   sight through the part's centroid, at the depth where its shadow has the part's
+//!   area.
+//!
+//! A move changes a body's launch velocity only (its spin is kept): the centre of mass
+//! of a free flight in a vacuum is at `c0 + v t + g t^2 / 2` at `t`, so the velocity
+//! that puts it at a point is exact. Every candidate is evaluated like any sample and
+//! ranked by the solver's rank (contacts first under the constraint mode); the best one
+//! is taken when it ranks better than the current best, and the search repeats from it.
+//! A pass costs `n (n - 1) / 2 + n` samples per accepted move, for `n` launched bodies.
+
+use glam::DVec3;
+
+use crate::energy::{Term, Weights, DIVERGED_ENERGY};
+use crate::geometry::shape::Shape;
+use crate::evaluate::{Evaluation, Held, Problem, Workspace};
+use crate::scene::Launch;
+
+/// Fraction of the light-to-receiver distance (along a line of sight) that a moved body's
+/// centre may take, at least: a body closer to the light than this casts a shadow over
+/// ten times its size.
+const MIN_DEPTH: f64 = 0.1;
+
+/// The turns tried for a body that is not a sphere (rad, about each world axis): a
+/// quarter turn either way and a half turn, added to its rotation by `t` through its
+/// launch spin (exact for a spin about a principal axis, close otherwise).
+const TURNS: [f64; 3] = [
+    std::f64::consts::FRAC_PI_2,
+    -std::f64::consts::FRAC_PI_2,
+    std::f64::consts::PI,
+];
+
+/// Clearance (m) kept between a moved body's lowest possible point and the table top.
+const TABLE_CLEARANCE: f64 = 0.01;
+
+/// Where one launched body is at `t`, as the moves see it.
+#[derive(Clone, Copy, Debug)]
+struct Sight {
+    /// The point of the receiver plane on the light's line through the centre of mass.
+    on_receiver: DVec3,
+    /// The centre's depth along that line: 0 at the light, 1 on the receiver.
+    depth: f64,
+    /// The body's own shadow area (pixels), alone, at its pose at `t`.
+    area: f64,
+}
+
+/// What one call of [`improve`] did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MoveReport {
+    /// Moves taken.
+    pub accepted: usize,
+    /// Samples evaluated.
+    pub samples: usize,
+    /// The launch of the candidate with the lowest energy of all, when it has a contact
+    /// and a lower energy than the launch kept: a better picture that a local search
+    /// may free of its contact (the caller may start a run from it).
+    pub promising: Option<Vec<f64>>,
+}
+
+/// Greedy moves of the occluders in `vary` from `params` (the launch of every
+/// occluder), whose evaluation is `best`: at most `max_moves` moves are taken, each the
+/// best-ranked candidate of a pass when it ranks better than the current launch.
+/// `params` and `best` are updated in place; `held` is the stage's (it holds only
+/// occluders not in `vary`).
+#[allow(clippy::too_many_arguments)]
+pub fn improve(
+    problem: &Problem,
+    held: &Held,
+    vary: &[usize],
+    weights: &Weights,
+    rank: &dyn Fn(&Evaluation) -> f64,
+    params: &mut [f64],
+    best: &mut Evaluation,
+    max_moves: usize,
+    ws: &mut Workspace,
+) -> MoveReport {
+    let scene = &problem.scene;
+    let movable: Vec<usize> = vary
+        .iter()
+        .copied()
+        .filter(|&i| scene.occluders[i].launched)
+        .collect();
+    let mut report = MoveReport::default();
+    if movable.is_empty() {
+        return report;
+    }
+    // Energies without the contact term: the picture and the scene's pulls.
+    let free =
+        |e: &Evaluation| e.total - weights.get(Term::Contact) * e.raw[Term::Contact as usize];
+    let mut candidate = params.to_vec();
+    let mut chosen = params.to_vec();
+    let mut promising: Option<(f64, Vec<f64>)> = None;
+    for _ in 0..max_moves {
+        let current = problem.evaluate_held(held, params, weights, ws);
+        let bare = problem.target.mask.and_not(&ws.mask);
+        let sights = sights(problem, &movable, ws);
+        let hole = bare
+            .blobs()
+            .into_iter()
+            .max_by(|a, b| a.0.cmp(&b.0).then(b.1.x.total_cmp(&a.1.x)));
+        let mut best_rank = rank(&current);
+        let mut found = None;
+        let mut consider = |candidate: &[f64], report: &mut MoveReport, ws: &mut Workspace| {
+            let e = problem.evaluate_held(held, candidate, weights, ws);
+            report.samples += 1;
+            if e.outcome.own_contact > 0.0
+                && e.total < DIVERGED_ENERGY
+                && promising.as_ref().is_none_or(|p| free(&e) < p.0)
+            {
+                promising = Some((free(&e), candidate.to_vec()));
+            }
+            if rank(&e) < best_rank {
+                best_rank = rank(&e);
+                chosen.copy_from_slice(candidate);
+                found = Some(e);
+            }
+        };
+        for (a, &i) in movable.iter().enumerate() {
+            for &j in &movable[a + 1..] {
+                let (Some(si), Some(sj)) = (sights[i], sights[j]) else {
+                    continue;
+                };
+                candidate.copy_from_slice(params);
+                send(problem, &mut candidate, i, sj.on_receiver, si, sj.area);
+                send(problem, &mut candidate, j, si.on_receiver, sj, si.area);
+                consider(&candidate, &mut report, ws);
+            }
+        }
+        if let Some((area, centroid)) = hole {
+            let on_receiver = scene.camera.pixel_to_world(centroid.x, centroid.y);
+            for &i in &movable {
+                let Some(si) = sights[i] else { continue };
+                candidate.copy_from_slice(params);
+                send(problem, &mut candidate, i, on_receiver, si, area as f64);
+                consider(&candidate, &mut report, ws);
+            }
+        }
+        for &i in &movable {
+            if matches!(scene.occluders[i].shape, Shape::Sphere { .. }) {
+                continue;
+            }
+            for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
+                for angle in TURNS {
+                    candidate.copy_from_slice(params);
+                    let mut launch = Launch::get(&candidate, i);
+                    launch.angular_velocity += axis * (angle / scene.t);
+                    launch.set(&mut candidate, i);
+                    consider(&candidate, &mut report, ws);
+                }
+            }
+        }
+        match found {
+            Some(e) => {
+                params.copy_from_slice(&chosen);
+                *best = e;
+                report.accepted += 1;
+            }
+            None => break,
+        }
+    }
+    // Leave the workspace holding the kept launch's flight and shadow.
+    *best = problem.evaluate_held(held, params, weights, ws);
+    report.promising = promising
+        .filter(|(energy, _)| *energy < free(best))
+        .map(|(_, launch)| launch);
+    report
+}
+
+/// The line of sight, depth and own shadow area of every launched body at `t`, after
+/// an evaluation on `ws`; `None` for a body whose shadow misses the picture or that is
+/// not between the light and the receiver.
+fn sights(problem: &Problem, movable: &[usize], ws: &mut Workspace) -> Vec<Option<Sight>> {
+    let scene = &problem.scene;
+    let n = scene.occluders.len();
+    let light = scene.camera.light;
+    let normal = scene.receiver.normal;
+    let mut out = vec![None; n];
+    let mut only = vec![false; n];
+    for &i in movable {
+        let (origin, q) = ws.poses[i];
+        let com = origin + q * scene.occluders[i].mass.local_com;
+        let down = (scene.receiver.center - light).dot(normal);
+        let along = (com - light).dot(normal);
+        if along.abs() < 1e-12 || down / along <= 1.0 {
+            continue;
+        }
+        let depth = along / down;
+        only.fill(false);
+        only[i] = true;
+        problem.shadow_only(&only, ws);
+        let area = ws.mask.count() as f64;
+        if area == 0.0 {
+            continue;
+        }
+        out[i] = Some(Sight {
+            on_receiver: light + (com - light) / depth,
+            depth,
+            area,
+        });
+    }
+    out
+}
+
+/// Set body `i`'s launch velocity in `params` so that its centre of mass is at `t` on
+/// the light's line through `on_receiver`, at the depth where its shadow (now `own`)
+/// has `area` pixels: the shadow's size goes as the inverse of the depth.
+fn send(problem: &Problem, params: &mut [f64], i: usize, on_receiver: DVec3, own: Sight, area: f64) {
+    let scene = &problem.scene;
+    let o = &scene.occluders[i];
+    let light = scene.camera.light;
+    let mut depth = own.depth * (own.area / area).sqrt();
+    // Keep the body's lowest point above the table (for a level table under the light).
+    if let Some(table) = &scene.table {
+        let top = table.top() + o.bounding_radius + TABLE_CLEARANCE;
+        let drop = light.z - on_receiver.z;
+        if drop > 0.0 && light.z > top {
+            depth = depth.min((light.z - top) / drop);
+        }
+    }
+    let depth = depth.clamp(MIN_DEPTH, 1.0);
+    let target = light + (on_receiver - light) * depth;
+    let t = scene.t;
+    let start = o.launch_com();
+    let velocity = (target - start - 0.5 * scene.gravity * t * t) / t;
+    let mut launch = Launch::get(params, i);
+    launch.velocity = velocity;
+    launch.set(params, i);
+}
