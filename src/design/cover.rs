@@ -29,11 +29,10 @@ const KEEP: usize = 6;
 pub const NEAR_M: f64 = 0.01;
 
 /// The vertical room two bodies whose shadows touch need between their centres at `t`
-/// (m): their half heights, plus as much again, plus a centimetre. The margin leaves
-/// room for the last part of the flight, when the two approach each other from the
-/// side at heights still closing in.
+/// (m): their half heights plus a centimetre. The flights' last part, when the two
+/// close in from the side at heights still apart, is checked by [`super::separate`].
 pub fn separation(e1: f64, e2: f64) -> f64 {
-    2.0 * (e1 + e2) + 0.01
+    1.0 * (e1 + e2) + 0.01
 }
 
 /// The picture's scale and the flight heights allowed.
@@ -115,6 +114,8 @@ pub struct Cover<'a> {
     owners: Vec<u64>,
     /// Height and half height of every placement so far.
     heights: Vec<(f64, f64)>,
+    /// The pose family of every placement.
+    families: Vec<Family>,
     pub placements: Vec<Placement>,
 }
 
@@ -140,6 +141,7 @@ impl<'a> Cover<'a> {
             value,
             owners: vec![0; picture.on.len()],
             heights: Vec::new(),
+            families: Vec::new(),
             placements: Vec::new(),
         }
     }
@@ -395,7 +397,74 @@ impl<'a> Cover<'a> {
     }
 
     /// Commit a placement: its pixels are covered, and it owns them and those near it.
-    pub fn commit(&mut self, p: Placement, pose: &Pose) {
+    pub fn commit(&mut self, p: Placement, family: Family) {
+        let pose = family.pose(p.alpha);
+        self.draw(self.placements.len(), &p, &pose);
+        self.heights
+            .push((self.frame.height(p.m), pose.half_height));
+        self.families.push(family);
+        self.placements.push(p);
+    }
+
+    /// Redraw the value and owner maps from every placement but `skip`.
+    fn redraw(&mut self, skip: Option<usize>) {
+        self.value = self
+            .picture
+            .on
+            .iter()
+            .map(|&b| if b { 1.0 } else { -1.0 })
+            .collect();
+        self.owners.iter_mut().for_each(|o| *o = 0);
+        for k in 0..self.placements.len() {
+            if Some(k) != skip {
+                let p = self.placements[k].clone();
+                let pose = self.families[k].pose(p.alpha);
+                self.draw(k, &p, &pose);
+            }
+        }
+    }
+
+    /// Undo the greedy's short sight: `rounds` times, each placement in turn is lifted
+    /// off and refined (pattern search from where it is) against all the others. An
+    /// early placement can then give up what a later one covers better (a wide shadow
+    /// over a junction, say). A placement's height rule is kept against the others.
+    pub fn polish(&mut self, rounds: usize) {
+        for _ in 0..rounds {
+            for k in 0..self.placements.len() {
+                self.redraw(Some(k));
+                let p = self.placements[k].clone();
+                let heights = std::mem::take(&mut self.heights);
+                // The placement's own height is not a constraint on itself.
+                self.heights = heights.clone();
+                self.heights[k] = (f64::NAN, 0.0);
+                let c = Candidate {
+                    centre: p.centre,
+                    theta: p.theta,
+                    m: p.m,
+                    alpha: p.alpha,
+                };
+                let (gain, c) = self.refine(&self.families[k].clone(), c);
+                self.heights = heights;
+                if gain.is_finite() {
+                    let pose = self.families[k].pose(c.alpha);
+                    let scale = c.m / self.frame.metres_per_px;
+                    self.placements[k] = Placement {
+                        alpha: c.alpha,
+                        centre: c.centre,
+                        theta: c.theta,
+                        m: c.m,
+                        gain,
+                        area: pose.outline.area() * scale * scale,
+                        ..p
+                    };
+                    self.heights[k] = (self.frame.height(c.m), pose.half_height);
+                }
+            }
+        }
+        self.redraw(None);
+    }
+
+    fn draw(&mut self, index: usize, p: &Placement, pose: &Pose) {
         let (w, h) = (self.picture.width, self.picture.height);
         let scale = p.m / self.frame.metres_per_px;
         let near = (NEAR_M * scale).ceil();
@@ -409,7 +478,7 @@ impl<'a> Cover<'a> {
             (p.centre.y - reach).floor().max(0.0) as usize,
             ((p.centre.y + reach).ceil() as usize).min(h),
         );
-        let bit = 1u64 << (self.placements.len() % 64);
+        let bit = 1u64 << (index % 64);
         let rings: Vec<DVec2> = (0..8)
             .map(|k| {
                 let a = k as f64 * std::f64::consts::FRAC_PI_4;
@@ -433,9 +502,6 @@ impl<'a> Cover<'a> {
                 }
             }
         }
-        self.heights
-            .push((self.frame.height(p.m), pose.half_height));
-        self.placements.push(p);
     }
 }
 

@@ -51,6 +51,9 @@ pub const AUTO_OPEN_SHARE: f64 = 0.01;
 /// ... or at this many objects of the automatic kind.
 pub const AUTO_CAP: usize = 24;
 
+/// Rounds of [`Cover::polish`] after the greedy pass.
+pub const POLISH_ROUNDS: usize = 2;
+
 /// Why a picture cannot be designed.
 #[derive(Debug, thiserror::Error)]
 pub enum DesignError {
@@ -86,7 +89,8 @@ pub fn design(
             index: k + 1,
             stem: objects[k].stem.clone(),
         })?;
-        cover.commit(p.clone(), &fams[p.family].pose(p.alpha));
+        let family = fams[p.family].clone();
+        cover.commit(p, family);
     }
     let target = picture.count() as f64;
     if let Some(auto) = &request.auto {
@@ -125,14 +129,15 @@ pub fn design(
             }
             let Some((p, o, i)) = best else { break };
             left[i] -= 1;
-            let pose = o.families()[p.family].pose(p.alpha);
+            let family = o.families()[p.family].clone();
             objects.push(o);
-            cover.commit(p, &pose);
+            cover.commit(p, family);
         }
     }
     if objects.is_empty() {
         return Err(DesignError::NothingWorthIt);
     }
+    cover.polish(POLISH_ROUNDS);
     Ok(Plan::new(geometry, objects, cover.placements))
 }
 
