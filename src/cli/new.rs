@@ -105,12 +105,13 @@ fn mesh_path(dir: &Path, obj: &Path) -> String {
     }
 }
 
+/// The prototypes of an inventory, the prototype of each item, and the `auto:` kind's
+/// prototypes with how many of each it may add.
+type Prototypes = (Vec<Prototype>, Vec<usize>, Vec<(usize, usize)>);
+
 /// The prototypes of the inventory: one per distinct item, then those of the `auto:`
 /// kind; and for each item, its prototype.
-fn prototypes(
-    dir: &Path,
-    inv: &Inventory,
-) -> Result<(Vec<Prototype>, Vec<usize>, Vec<(usize, usize)>)> {
+fn prototypes(dir: &Path, inv: &Inventory) -> Result<Prototypes> {
     let mut protos: Vec<(Kind, f64)> = Vec::new();
     let mut of_item = Vec::new();
     for item in &inv.items {

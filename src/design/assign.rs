@@ -125,7 +125,7 @@ mod tests {
             .map(|&(x, y)| {
                 slots
                     .iter()
-                    .map(|&s| ((x - s) * (x - s) + y * y as f64).sqrt())
+                    .map(|&s| ((x - s) * (x - s) + y * y).sqrt())
                     .collect()
             })
             .collect();
