@@ -1,18 +1,25 @@
-//! `bsa new`: a scene from a picture and a box of objects ([`crate::design`]): the
-//! objects laid out on the floor in front of the picture, one hint per object where it
-//! covers the most of the picture ([`crate::design::cover`]), the start guess aimed at
-//! the hints, the default strategy; and `start.png`, the start guess over the target.
+//! `bsa new`: a scene from a picture and a box of objects ([`crate::design`]). The
+//! objects' shapes are loaded (and checked) through a first scene file that holds one
+//! of each; the design places their shadows on the picture, plans the launches and
+//! writes the scene; the start guess is then made contact-free with the exact contact
+//! search and the scene written again; `start.png` shows the start guess over the
+//! target. Everything the user reads (the start IoU, a contact) comes from the scene
+//! file as written, loaded afresh.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
+use serde_json::{json, Value};
 
-use crate::design::cover;
-use crate::design::inventory::Item;
-use crate::design::plant::{Layout, Stage};
+use crate::design::inventory::{AutoKind, Inventory, Kind};
+use crate::design::launch::{Geometry, Object};
+use crate::design::picture::Picture;
+use crate::design::plant::{default_strategy, Stage};
+use crate::design::{self, chess, separate, AutoRequest, Request};
 use crate::energy::Weights;
 use crate::evaluate::Problem;
 use crate::output::files;
+use crate::scene::Scene;
 
 use super::plant::Design;
 use super::{load, NewArgs};
@@ -21,7 +28,7 @@ use super::{load, NewArgs};
 pub(super) struct Options {
     dir: PathBuf,
     target: PathBuf,
-    items: Vec<Item>,
+    inventory: Inventory,
     seed: u64,
     stage: Stage,
 }
@@ -32,11 +39,128 @@ impl Options {
         Ok(Options {
             dir: args.dir,
             target: args.target,
-            items: design.items,
+            inventory: design.inventory,
             seed: design.seed,
             stage: design.stage,
         })
     }
+}
+
+/// One distinct object of the inventory, as the scene file writes it.
+struct Prototype {
+    stem: String,
+    shape: Value,
+    density: f64,
+}
+
+/// The scene file's shape of a kind (chess pieces are written beside the scene).
+fn prototype(dir: &Path, kind: &Kind, density: f64) -> Result<Prototype> {
+    let (stem, shape) = match kind {
+        Kind::Sphere { radius } => ("sphere".to_string(), json!({"sphere": {"radius": radius}})),
+        Kind::Box { size } => ("box".to_string(), json!({"box": {"size": size}})),
+        Kind::Mesh { obj, scale } => {
+            let stem = obj
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("mesh")
+                .to_string();
+            (
+                stem,
+                json!({"mesh": {"obj": mesh_path(dir, obj), "scale": scale}}),
+            )
+        }
+        Kind::Chess { piece } => {
+            let rel = format!("pieces/{piece}.obj");
+            let path = dir.join(&rel);
+            let text = chess::obj(piece).expect("checked by the inventory");
+            match std::fs::read(&path) {
+                Ok(old) if old == text.as_bytes() => {}
+                Ok(_) => bail!(
+                    "{} exists and is not the built-in {piece}: remove it, or list it as mesh:{}",
+                    path.display(),
+                    path.display()
+                ),
+                Err(_) => files::write_atomic(&path, text.as_bytes())?,
+            }
+            (piece.clone(), json!({"mesh": {"obj": rel}}))
+        }
+    };
+    Ok(Prototype {
+        stem,
+        shape,
+        density,
+    })
+}
+
+/// An OBJ path as the scene in `dir` names it: relative when the file is inside `dir`,
+/// else absolute.
+fn mesh_path(dir: &Path, obj: &Path) -> String {
+    let abs = std::fs::canonicalize(obj).unwrap_or_else(|_| obj.to_path_buf());
+    match std::fs::canonicalize(dir)
+        .ok()
+        .and_then(|d| abs.strip_prefix(d).ok().map(Path::to_path_buf))
+    {
+        Some(rel) => rel.display().to_string(),
+        None => abs.display().to_string(),
+    }
+}
+
+/// The prototypes of an inventory, the prototype of each item, and the `auto:` kind's
+/// prototypes with how many of each it may add.
+type Prototypes = (Vec<Prototype>, Vec<usize>, Vec<(usize, usize)>);
+
+/// The prototypes of the inventory: one per distinct item, then those of the `auto:`
+/// kind; and for each item, its prototype.
+fn prototypes(dir: &Path, inv: &Inventory) -> Result<Prototypes> {
+    let mut protos: Vec<(Kind, f64)> = Vec::new();
+    let mut of_item = Vec::new();
+    for item in &inv.items {
+        let at = protos
+            .iter()
+            .position(|p| p.0 == item.kind && p.1 == item.density)
+            .unwrap_or_else(|| {
+                protos.push((item.kind.clone(), item.density));
+                protos.len() - 1
+            });
+        of_item.push(at);
+    }
+    // The auto: kind's prototypes and how many of each it may add.
+    let mut auto = Vec::new();
+    if let Some(a) = &inv.auto {
+        let cap = design::AUTO_CAP;
+        let kinds: Vec<(Kind, usize)> = match &a.kind {
+            AutoKind::Sphere { radius: Some(r) } => vec![(Kind::Sphere { radius: *r }, cap)],
+            AutoKind::Sphere { radius: None } => Vec::new(),
+            AutoKind::Box { size } => vec![(Kind::Box { size: *size }, cap)],
+            AutoKind::Mesh { obj, scale } => vec![(
+                Kind::Mesh {
+                    obj: obj.clone(),
+                    scale: *scale,
+                },
+                cap,
+            )],
+            AutoKind::Chess => chess::PIECES
+                .iter()
+                .map(|(p, n)| {
+                    (
+                        Kind::Chess {
+                            piece: p.to_string(),
+                        },
+                        *n,
+                    )
+                })
+                .collect(),
+        };
+        for (kind, n) in kinds {
+            protos.push((kind, a.density));
+            auto.push((protos.len() - 1, n));
+        }
+    }
+    let protos = protos
+        .iter()
+        .map(|(k, d)| prototype(dir, k, *d))
+        .collect::<Result<Vec<_>>>()?;
+    Ok((protos, of_item, auto))
 }
 
 pub(super) fn run(opts: &Options) -> Result<()> {
@@ -48,7 +172,6 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         pixels: (img.width() as usize, img.height() as usize),
         ..opts.stage.clone()
     };
-    let layout = Layout::new(stage.clone(), &opts.items)?;
     let dir = &opts.dir;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     files::write_atomic(&dir.join("target.png"), &bytes)?;
@@ -58,32 +181,56 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         .unwrap_or("scene")
         .to_string();
     let scene_file = dir.join("scene.json");
-    let write_scene = |hints: &[(usize, glam::DVec2)]| -> Result<()> {
-        let json = layout.scene_json(&name, "target.png", hints, opts.seed);
-        files::write_atomic(&scene_file, serde_json::to_string_pretty(&json)?.as_bytes())?;
+    let write = |json: &Value| -> Result<()> {
+        files::write_atomic(&scene_file, serde_json::to_string_pretty(json)?.as_bytes())?;
         Ok(())
     };
-    write_scene(&[])?;
-    let problem = Problem::new(
-        load::scene(dir).with_context(|| format!("from --target {}", opts.target.display()))?,
-    );
-    // An object whose shadow is wider than the picture cannot be part of it.
-    let scene = &problem.scene;
-    for o in &scene.occluders {
-        let shadow = 2.0 * o.bounding_radius * 1.5;
-        if shadow > scene.receiver.width.min(scene.receiver.height) {
-            bail!(
-                "object `{}` ({:.3} m across) casts a shadow of about {:.2} m, larger than the {:.2} x {:.2} m picture: use a wider picture (--width) or smaller objects",
-                o.name,
-                2.0 * o.bounding_radius,
-                shadow,
-                scene.receiver.width,
-                scene.receiver.height
-            );
-        }
+    // A first scene with one object of each kind, far apart above the table: loading it
+    // reads and checks the target and every mesh.
+    let (protos, of_item, auto) = prototypes(dir, &opts.inventory)?;
+    let mut probe = probe_json(&protos, &stage, &name);
+    if protos.is_empty() {
+        // auto:sphere alone: a placeholder sphere, so that the scene loads.
+        probe["occluders"] = json!([{"name": "probe", "shape": {"sphere": {"radius": 0.01}},
+                                     "position": [0.0, 0.0, 1.0], "density": 1000.0}]);
     }
-    let hints = cover::cover_hints(&problem, &problem.target.mask);
-    write_scene(&hints)?;
+    write(&probe)?;
+    let scene = load::scene(dir)
+        .with_context(|| format!("from --target {} and --objects", opts.target.display()))?;
+    check_sizes(&scene, protos.len())?;
+    let objects: Vec<Object> = protos
+        .iter()
+        .zip(&scene.occluders)
+        .map(|(p, o)| Object {
+            stem: p.stem.clone(),
+            shape: o.shape.clone(),
+            shape_json: p.shape.clone(),
+            density: p.density,
+        })
+        .collect();
+    let request = Request {
+        fixed: of_item.iter().map(|&k| objects[k].clone()).collect(),
+        auto: opts.inventory.auto.as_ref().map(|a| match a.kind {
+            AutoKind::Sphere { radius: None } => AutoRequest::Spheres { density: a.density },
+            _ => AutoRequest::Objects(auto.iter().map(|&(k, n)| (objects[k].clone(), n)).collect()),
+        }),
+    };
+    let mask = &scene.target;
+    let (w, h) = (mask.width(), mask.height());
+    let picture = Picture::new(w, h, (0..w * h).map(|k| mask.get(k % w, k / w)).collect());
+    let geometry = Geometry {
+        camera: scene.camera.clone(),
+        table_top: scene.table.as_ref().map_or(0.0, |t| t.top()),
+        gravity: scene.gravity,
+        t: scene.t,
+    };
+    let mut plan = design::design(&picture, geometry, &request)?;
+    write(&plan.scene_json(&name, "target.png", opts.seed))?;
+    let mut problem = Problem::new(load::scene(dir)?);
+    let n = plan.objects.len();
+    let sep = separate::separate(&mut plan, &mut problem, 4 * n + 10);
+    write(&plan.scene_json(&name, "target.png", opts.seed))?;
+    // What the user gets: the scene as written, loaded afresh.
     let problem = Problem::new(load::scene(dir)?);
     let mut ws = problem.workspace();
     let start = problem.evaluate(
@@ -97,18 +244,66 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         &ws.mask,
         &format!("{name}: the start guess at t, before any solve"),
     )?;
+    let heights: Vec<f64> = (0..n).map(|k| plan.height(k)).collect();
+    let chosen = n - opts.inventory.items.len();
     println!(
-        "{}: {} objects; start guess IoU {:.4}{}; wrote {}/{{scene.json, target.png, start.png}}; next: bsa solve {}",
+        "{}: {} objects{}; heights at t {:.2} to {:.2} m; {} move{} to keep the flights apart; start guess IoU {:.4}, {}; wrote {}/{{scene.json, target.png, start.png}}; next: bsa solve {}",
         name,
-        layout.len(),
+        n,
+        if opts.inventory.auto.is_some() { format!(" ({chosen} chosen by auto:)") } else { String::new() },
+        heights.iter().copied().fold(f64::INFINITY, f64::min),
+        heights.iter().copied().fold(0.0, f64::max),
+        sep.moves,
+        if sep.moves == 1 { "" } else { "s" },
         start.iou,
         if start.outcome.n_contacts > 0 {
-            format!(" (with a contact at {:.3} s)", start.outcome.t_sim)
+            format!("with a contact at {:.3} s (the solver treats it as a penalty)", start.outcome.t_sim)
         } else {
-            String::new()
+            "no contact before t".to_string()
         },
         dir.display(),
         dir.display()
     );
     Ok(())
+}
+
+/// An object whose shadow is wider than the picture cannot be part of it.
+fn check_sizes(scene: &Scene, count: usize) -> Result<()> {
+    for o in scene.occluders.iter().take(count) {
+        let shadow = 2.0 * o.bounding_radius * 1.5;
+        if shadow > scene.receiver.width.min(scene.receiver.height) {
+            bail!(
+                "object `{}` ({:.3} m across) casts a shadow of about {:.2} m, larger than the {:.2} x {:.2} m picture: use a wider picture (--width) or smaller objects",
+                o.name,
+                2.0 * o.bounding_radius,
+                shadow,
+                scene.receiver.width,
+                scene.receiver.height
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The first scene file: the stage and one object of each kind.
+fn probe_json(protos: &[Prototype], stage: &Stage, name: &str) -> Value {
+    let occluders: Vec<Value> = protos
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            json!({"name": format!("{}_{}", p.stem, k + 1), "shape": p.shape,
+                       "position": [0.0, -30.0, 100.0 + 10.0 * k as f64], "density": p.density})
+        })
+        .collect();
+    json!({
+        "name": name,
+        "target": "target.png",
+        "t": stage.t,
+        "light": [0.0, 0.0, stage.light_height],
+        "receiver": {"center": [0.0, 0.0, 0.0], "u": [1.0, 0.0, 0.0], "v": [0.0, 1.0, 0.0],
+                     "width": stage.picture_width, "height": stage.picture_height()},
+        "table": {"center": [0.0, 0.0, -0.5], "size": [40.0, 40.0, 1.0]},
+        "occluders": occluders,
+        "strategy": default_strategy(protos.len().max(1)),
+    })
 }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 
-use crate::design::inventory::{self, Item};
+use crate::design::inventory::{self, Inventory, Item};
 use crate::design::plant::{self, Layout, Stage};
 use crate::energy::Weights;
 use crate::evaluate::Problem;
@@ -29,9 +29,12 @@ pub(super) struct Options {
 impl Options {
     pub(super) fn new(args: PlantArgs) -> Result<Options> {
         let design = Design::new(args.design)?;
+        if design.inventory.auto.is_some() {
+            bail!("--objects: bsa plant draws a fixed box of objects; auto: items are for bsa new");
+        }
         Ok(Options {
             dir: args.dir,
-            items: design.items,
+            items: design.inventory.items,
             seed: design.seed,
             stage: design.stage,
         })
@@ -40,14 +43,14 @@ impl Options {
 
 /// The validated objects and stage of `bsa new` and `bsa plant`.
 pub(super) struct Design {
-    pub(super) items: Vec<Item>,
+    pub(super) inventory: Inventory,
     pub(super) seed: u64,
     pub(super) stage: Stage,
 }
 
 impl Design {
     pub(super) fn new(args: DesignArgs) -> Result<Design> {
-        let items = inventory::parse(&args.objects).context("--objects")?;
+        let inventory = read_inventory(&args.objects)?;
         for (name, value, lo, hi) in [
             ("--width", args.width, 0.01, 1000.0),
             ("--light-height", args.light_height, 0.1, 1000.0),
@@ -58,7 +61,7 @@ impl Design {
             }
         }
         Ok(Design {
-            items,
+            inventory,
             seed: args.seed,
             stage: Stage {
                 picture_width: args.width,
@@ -68,6 +71,20 @@ impl Design {
             },
         })
     }
+}
+
+/// The `--objects` argument: a list, or a JSON file (a name ending in `.json`) whose
+/// mesh paths are relative to its folder.
+fn read_inventory(arg: &str) -> Result<Inventory> {
+    if arg.to_ascii_lowercase().ends_with(".json") {
+        let path = std::path::Path::new(arg);
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("--objects: cannot read {}", path.display()))?;
+        let base = path.parent().unwrap_or(std::path::Path::new("."));
+        return inventory::parse_json(&text, base)
+            .with_context(|| format!("--objects {}", path.display()));
+    }
+    inventory::parse(arg).context("--objects")
 }
 
 pub(super) fn run(opts: &Options) -> Result<()> {

@@ -1,116 +1,688 @@
-//! Where each object goes in a user's picture: [`cover_hints`] places one hint per
-//! object, largest first, where a square the size of its shadow covers the most of the
-//! target not yet covered by the objects placed before it. The shadow's size is the
-//! object's bounding radius magnified as at a third of the light's height (the middle of
-//! the heights the start guess uses). `bsa new` writes these hints; the scene's start
-//! guess then aims every object at its hint.
+//! Where each object's shadow goes: a greedy cover of the picture by the objects'
+//! magnified top views ([`cover`]).
+//!
+//! Largest object first, each object takes the placement (pose, roll, centre, angle,
+//! magnification) whose shadow gains the most: +1 per target pixel not yet covered,
+//! -1 per background pixel not yet covered (the solver's XOR term, so a shadow that
+//! spills is worth less than one that fits), 0 on pixels already covered. Candidate
+//! centres are the ridge of the distance transform of the target left uncovered (the
+//! centre lines of the strokes still open), angles the local direction of the
+//! picture there (so elongated objects go along strokes) and every 30 degrees,
+//! magnifications a geometric range between the lowest and highest flight the stage
+//! allows. The best few are refined by a pattern search over all their parameters.
+//!
+//! Two shadows that overlap (or come within [`NEAR_M`] of each other at their
+//! height) belong to bodies that would meet at `t` at one height, so a placement that
+//! touches an earlier one must fly at a height at least [`separation`] apart from it.
 
 use glam::DVec2;
 
-use crate::evaluate::Problem;
-use crate::shadow::mask::Mask;
+use super::picture::Picture;
+use super::pose::{Family, Outline, Pose};
 
-/// Fraction of the light's height at which an object's shadow size is judged.
-const HEIGHT_FRACTION: f64 = 1.0 / 3.0;
+/// Sample points per outline in the coarse search and in the refinement.
+const COARSE_SAMPLES: usize = 120;
+const FINE_SAMPLES: usize = 500;
+/// Placements kept from the coarse search for refinement.
+const KEEP: usize = 6;
+/// Shadows closer than this (m, at the body's height) count as touching.
+pub const NEAR_M: f64 = 0.01;
 
-/// One hint pixel per launched occluder (occluder index, pixel), largest object first.
-pub fn cover_hints(problem: &Problem, target: &Mask) -> Vec<(usize, DVec2)> {
-    let scene = &problem.scene;
-    let (w, h) = (target.width(), target.height());
-    let metres_per_px = scene.receiver.width / w as f64;
-    let magnification = 1.0 / (1.0 - HEIGHT_FRACTION);
-    let mut open: Vec<u32> = (0..w * h)
-        .map(|k| u32::from(target.get(k % w, k / w)))
-        .collect();
-    let occ = &scene.occluders;
-    let mut order: Vec<usize> = (0..occ.len()).filter(|&i| occ[i].launched).collect();
-    order.sort_by(|&a, &b| {
-        occ[b]
-            .bounding_radius
-            .total_cmp(&occ[a].bounding_radius)
-            .then(a.cmp(&b))
-    });
-    let mut sums = vec![0u32; (w + 1) * (h + 1)];
-    let mut out = Vec::new();
-    for i in order {
-        let r = occ[i].bounding_radius * magnification / metres_per_px;
-        // A square of the disc's area.
-        let half = ((0.5 * r * std::f64::consts::PI.sqrt()).round() as usize).max(1);
-        integrate(&open, w, h, &mut sums);
-        let window = |x: usize, y: usize| -> u32 {
-            let (x0, y0) = (x.saturating_sub(half), y.saturating_sub(half));
-            let (x1, y1) = ((x + half + 1).min(w), (y + half + 1).min(h));
-            let at = |x: usize, y: usize| sums[y * (w + 1) + x];
-            at(x1, y1) + at(x0, y0) - at(x0, y1) - at(x1, y0)
+/// The vertical room two bodies whose shadows touch need between their centres at `t`
+/// (m): their half heights, plus as much again, plus a centimetre. The margin leaves
+/// room for the last part of the flight, when the two close in from the side at
+/// heights still closing in (on THE THINKER's pieces, half the margin costs 0.02 to
+/// 0.04 of final IoU: more flights meet and [`super::separate`] must move them).
+pub fn separation(e1: f64, e2: f64) -> f64 {
+    2.0 * (e1 + e2) + 0.01
+}
+
+/// The picture's scale and the flight heights allowed.
+#[derive(Clone, Copy, Debug)]
+pub struct Frame {
+    /// Metres per pixel on the receiver.
+    pub metres_per_px: f64,
+    /// Height of the light above the receiver (m).
+    pub light_height: f64,
+    /// Lowest and highest magnification (heights between a tenth and four fifths of
+    /// the light's).
+    pub m_lo: f64,
+    pub m_hi: f64,
+}
+
+impl Frame {
+    pub fn new(metres_per_px: f64, light_height: f64) -> Frame {
+        Frame {
+            metres_per_px,
+            light_height,
+            m_lo: 1.0 / (1.0 - 0.1),
+            m_hi: 1.0 / (1.0 - 0.8),
+        }
+    }
+
+    /// Height above the receiver (m) at which a body's shadow is magnified `m` times.
+    pub fn height(&self, m: f64) -> f64 {
+        self.light_height * (1.0 - 1.0 / m)
+    }
+
+    /// The magnification at height `z`.
+    pub fn magnification(&self, z: f64) -> f64 {
+        self.light_height / (self.light_height - z)
+    }
+}
+
+/// Where one object's shadow goes.
+#[derive(Clone, Debug)]
+pub struct Placement {
+    /// Index of the object (in the order given to [`cover`]).
+    pub object: usize,
+    /// Index of its pose family and the roll within it.
+    pub family: usize,
+    pub alpha: f64,
+    /// Centre of the shadow (pixels).
+    pub centre: DVec2,
+    /// Direction of the outline's x axis on the picture (rad, counter-clockwise, image up).
+    pub theta: f64,
+    /// Magnification.
+    pub m: f64,
+    /// What it gained (pixels: new target minus new background).
+    pub gain: f64,
+    /// Its shadow's area (pixels).
+    pub area: f64,
+}
+
+/// The pixel of the outline point `d` (m) of a shadow centred on `c`, turned by
+/// `theta`, magnified `m` times, at `metres_per_px`.
+pub fn to_pixel(c: DVec2, theta: f64, scale: f64, d: DVec2) -> DVec2 {
+    let (s, co) = theta.sin_cos();
+    c + scale * DVec2::new(d.x * co - d.y * s, -(d.x * s + d.y * co))
+}
+
+fn from_pixel(c: DVec2, theta: f64, scale: f64, p: DVec2) -> DVec2 {
+    let q = (p - c) / scale;
+    let (s, co) = theta.sin_cos();
+    // Inverse of to_pixel: (qx, -qy) = R(theta) d.
+    let (x, y) = (q.x, -q.y);
+    DVec2::new(x * co + y * s, -x * s + y * co)
+}
+
+/// The state of the cover: what each pixel is worth and who is on it.
+pub struct Cover<'a> {
+    picture: &'a Picture,
+    frame: Frame,
+    /// +1 target not yet covered, -1 background not yet covered, 0 covered.
+    value: Vec<f32>,
+    /// Bit k: placement k's shadow is on (or near) this pixel.
+    owners: Vec<u64>,
+    /// Height and half height of every placement so far.
+    heights: Vec<(f64, f64)>,
+    /// The pose family of every placement.
+    families: Vec<Family>,
+    pub placements: Vec<Placement>,
+}
+
+/// One candidate being scored.
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    centre: DVec2,
+    theta: f64,
+    m: f64,
+    alpha: f64,
+}
+
+impl<'a> Cover<'a> {
+    pub fn new(picture: &'a Picture, frame: Frame) -> Cover<'a> {
+        let value = picture
+            .on
+            .iter()
+            .map(|&b| if b { 1.0 } else { -1.0 })
+            .collect();
+        Cover {
+            picture,
+            frame,
+            value,
+            owners: vec![0; picture.on.len()],
+            heights: Vec::new(),
+            families: Vec::new(),
+            placements: Vec::new(),
+        }
+    }
+
+    /// Target pixels not yet covered.
+    pub fn open(&self) -> usize {
+        self.value.iter().filter(|&&v| v > 0.0).count()
+    }
+
+    /// The uncovered target as a picture.
+    fn open_picture(&self) -> Picture {
+        Picture::new(
+            self.picture.width,
+            self.picture.height,
+            self.value.iter().map(|&v| v > 0.0).collect(),
+        )
+    }
+
+    /// Score of a shadow with these samples: the gain, or `None` if it touches an
+    /// earlier shadow without the height separation.
+    fn score(&self, samples: &[(DVec2, f64)], c: &Candidate, half_height: f64) -> Option<f64> {
+        let (w, h) = (self.picture.width, self.picture.height);
+        let scale = c.m / self.frame.metres_per_px;
+        let px_area = scale * scale;
+        let (mut gain, mut touch) = (0.0f64, 0u64);
+        for (d, a) in samples {
+            let p = to_pixel(c.centre, c.theta, scale, *d);
+            let v = if p.x < 0.0 || p.y < 0.0 || p.x >= w as f64 || p.y >= h as f64 {
+                -1.0
+            } else {
+                let k = p.y as usize * w + p.x as usize;
+                touch |= self.owners[k];
+                self.value[k] as f64
+            };
+            gain += v * a * px_area;
+        }
+        let z = self.frame.height(c.m);
+        while touch != 0 {
+            let j = touch.trailing_zeros() as usize;
+            touch &= touch - 1;
+            let (zj, ej) = self.heights[j];
+            if (z - zj).abs() < separation(half_height, ej) {
+                return None;
+            }
+        }
+        Some(gain)
+    }
+
+    /// Place object `object` (index for the record) with the pose families `families`:
+    /// the best placement found, not yet committed.
+    pub fn best(&self, object: usize, families: &[Family]) -> Option<Placement> {
+        let open = self.open_picture();
+        let source = if open.count() > 0 {
+            &open
+        } else {
+            self.picture
         };
-        let (mut best, mut at) = (0u32, (w / 2, h / 2));
-        for y in 0..h {
-            for x in 0..w {
-                let s = window(x, y);
-                if s > best {
-                    best = s;
-                    at = (x, y);
+        let dist = source.distance();
+        let mut ridge = source.ridge(&dist);
+        thin(
+            &mut ridge,
+            &dist,
+            source.width,
+            (source.width.max(source.height) / 120).max(2),
+        );
+        let dirs: Vec<f64> = ridge
+            .iter()
+            .map(|&(x, y)| {
+                let r = (2.5 * dist[y * source.width + x] as f64).max(6.0);
+                self.picture.direction(x, y, r)
+            })
+            .collect();
+        let scales: Vec<f64> = (0..10)
+            .map(|k| self.frame.m_lo * (self.frame.m_hi / self.frame.m_lo).powf(k as f64 / 9.0))
+            .collect();
+        let mut kept: Vec<(f64, usize, Candidate)> = Vec::new();
+        for (fi, fam) in families.iter().enumerate() {
+            for alpha in fam.alphas() {
+                let pose = fam.pose(alpha);
+                let samples = pose.outline.samples(COARSE_SAMPLES);
+                for (k, &(x, y)) in ridge.iter().enumerate() {
+                    let centre = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+                    let thetas: Vec<f64> = if pose.outline.round() {
+                        vec![0.0]
+                    } else {
+                        let d = dirs[k];
+                        let mut t = vec![d, d + 0.26, d - 0.26];
+                        t.extend((0..6).map(|i| i as f64 * std::f64::consts::PI / 6.0));
+                        t
+                    };
+                    for &m in &scales {
+                        for &theta in &thetas {
+                            let c = Candidate {
+                                centre,
+                                theta,
+                                m,
+                                alpha,
+                            };
+                            if let Some(s) = self.score(&samples, &c, pose.half_height) {
+                                keep(&mut kept, (s, fi, c));
+                            }
+                        }
+                    }
                 }
             }
         }
-        if best == 0 {
-            // Everything is covered: the target's densest point.
-            at = densest(target, half).unwrap_or(at);
-        }
-        let c = DVec2::new(at.0 as f64 + 0.5, at.1 as f64 + 0.5);
-        for y in at.1.saturating_sub(half)..(at.1 + half + 1).min(h) {
-            for x in at.0.saturating_sub(half)..(at.0 + half + 1).min(w) {
-                open[y * w + x] = 0;
+        let mut best: Option<(f64, usize, Candidate)> = None;
+        for (_, fi, c) in kept {
+            let (s, c) = self.refine(&families[fi], c);
+            if best.as_ref().is_none_or(|b| s > b.0) {
+                best = Some((s, fi, c));
             }
         }
-        out.push((i, c));
+        let (gain, family, c) = best?;
+        let pose = families[family].pose(c.alpha);
+        let scale = c.m / self.frame.metres_per_px;
+        Some(Placement {
+            object,
+            family,
+            alpha: c.alpha,
+            centre: c.centre,
+            theta: c.theta,
+            m: c.m,
+            gain,
+            area: pose.outline.area() * scale * scale,
+        })
     }
-    out.sort_by_key(|h| h.0);
-    out
-}
 
-/// Summed-area table of `values` (`w x h`) into `sums` (`(w + 1) x (h + 1)`).
-fn integrate(values: &[u32], w: usize, h: usize, sums: &mut [u32]) {
-    for y in 0..h {
-        let mut row = 0;
-        for x in 0..w {
-            row += values[y * w + x];
-            sums[(y + 1) * (w + 1) + x + 1] = sums[y * (w + 1) + x + 1] + row;
+    /// The sphere that gains most, for `auto:sphere`: centred on the ridge of the target
+    /// (or of what is left of it), as large as the target allows there, flying at the
+    /// magnification nearest 2 (half the light's height) that the height rule allows.
+    /// Returns the placement and the sphere's radius (m, whole millimetres).
+    pub fn best_disc(&self, object: usize) -> Option<(Placement, f64)> {
+        let w = self.picture.width;
+        let full = self.picture.distance();
+        let open = self.open_picture();
+        let mut cands = self.picture.ridge(&full);
+        cands.extend(open.ridge(&open.distance()));
+        thin(
+            &mut cands,
+            &full,
+            w,
+            (w.max(self.picture.height) / 120).max(2),
+        );
+        let mut prefs: Vec<f64> = (0..10)
+            .map(|k| self.frame.m_lo * (self.frame.m_hi / self.frame.m_lo).powf(k as f64 / 9.0))
+            .collect();
+        prefs.sort_by(|a, b| (a / 2.0).ln().abs().total_cmp(&(b / 2.0).ln().abs()));
+        let p = self.frame.metres_per_px;
+        let mut best: Option<(f64, Candidate, f64)> = None;
+        for (x, y) in cands {
+            let r_px = full[y * w + x] as f64 + 0.5;
+            if r_px < 3.0 {
+                continue;
+            }
+            let centre = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+            for &m in &prefs {
+                let r = (r_px * p / m * 1000.0).round() / 1000.0;
+                if r < 0.005 {
+                    continue;
+                }
+                let samples = Outline::Disc { r }.samples(COARSE_SAMPLES);
+                let c = Candidate {
+                    centre,
+                    theta: 0.0,
+                    m,
+                    alpha: 0.0,
+                };
+                if let Some(g) = self.score(&samples, &c, r) {
+                    if best.as_ref().is_none_or(|b| g > b.0) {
+                        best = Some((g, c, r));
+                    }
+                    break;
+                }
+            }
+        }
+        let (gain, c, r) = best?;
+        let scale = c.m / p;
+        Some((
+            Placement {
+                object,
+                family: 0,
+                alpha: 0.0,
+                centre: c.centre,
+                theta: 0.0,
+                m: c.m,
+                gain,
+                area: Outline::Disc { r }.area() * scale * scale,
+            },
+            r,
+        ))
+    }
+
+    /// Pattern search from `c` over centre, angle, magnification (and roll).
+    fn refine(&self, fam: &Family, mut c: Candidate) -> (f64, Candidate) {
+        let mut pose = fam.pose(c.alpha);
+        let mut samples = pose.outline.samples(FINE_SAMPLES);
+        let eval = |pose: &Pose, samples: &[(DVec2, f64)], c: &Candidate| -> f64 {
+            if c.m < self.frame.m_lo || c.m > self.frame.m_hi {
+                return f64::NEG_INFINITY;
+            }
+            self.score(samples, c, pose.half_height)
+                .unwrap_or(f64::NEG_INFINITY)
+        };
+        let mut best = eval(&pose, &samples, &c);
+        let round = pose.outline.round();
+        let mut step = [4.0, 4.0, 0.12, 0.06, 0.2];
+        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..40 {
+            let mut improved = false;
+            for (p, s) in step.iter().enumerate() {
+                if (p == 2 && round) || (p == 4 && !fam.rolls()) {
+                    continue;
+                }
+                for sign in [-1.0, 1.0] {
+                    let mut n = c;
+                    match p {
+                        0 => n.centre.x += sign * s,
+                        1 => n.centre.y += sign * s,
+                        2 => n.theta += sign * s,
+                        3 => n.m *= (sign * s).exp(),
+                        _ => n.alpha = (n.alpha + sign * s).clamp(0.0, std::f64::consts::FRAC_PI_2),
+                    }
+                    if p == 3 {
+                        // Also grow or shrink from either end (on a plateau of the
+                        // samples, length and centre only improve together).
+                        let half = pose.outline.half_extents().x / self.frame.metres_per_px;
+                        let shift = half * (n.m - c.m);
+                        let dir = DVec2::new(c.theta.cos(), -c.theta.sin());
+                        for end in [-1.0, 1.0] {
+                            let mut g = n;
+                            g.centre += end * shift * dir;
+                            let v = eval(&pose, &samples, &g);
+                            if v > best + 1e-9 {
+                                best = v;
+                                c = g;
+                                improved = true;
+                            }
+                        }
+                    }
+                    let (np, ns);
+                    let (pp, ss) = if p == 4 {
+                        np = fam.pose(n.alpha);
+                        ns = np.outline.samples(FINE_SAMPLES);
+                        (&np, &ns[..])
+                    } else {
+                        (&pose, &samples[..])
+                    };
+                    let v = eval(pp, ss, &n);
+                    if v > best + 1e-9 {
+                        best = v;
+                        c = n;
+                        if p == 4 {
+                            pose = pp.clone();
+                            samples = ss.to_vec();
+                        }
+                        improved = true;
+                    }
+                }
+            }
+            // Moves of all parameters at once (random directions, scaled by the
+            // steps): the shadow's length, width and centre often only improve
+            // together.
+            for _ in 0..16 {
+                let mut r = [0.0f64; 5];
+                for x in r.iter_mut() {
+                    rng ^= rng << 13;
+                    rng ^= rng >> 7;
+                    rng ^= rng << 17;
+                    *x = (rng >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+                }
+                let mut n = c;
+                n.centre += DVec2::new(r[0] * step[0], r[1] * step[1]);
+                if !round {
+                    n.theta += r[2] * step[2];
+                }
+                n.m *= (r[3] * step[3]).exp();
+                let rolled;
+                let (pp, ss) = if fam.rolls() {
+                    n.alpha = (n.alpha + r[4] * step[4]).clamp(0.0, std::f64::consts::FRAC_PI_2);
+                    let q = fam.pose(n.alpha);
+                    rolled = (q.outline.samples(FINE_SAMPLES), q);
+                    (&rolled.1, &rolled.0[..])
+                } else {
+                    (&pose, &samples[..])
+                };
+                let v = eval(pp, ss, &n);
+                if v > best + 1e-9 {
+                    best = v;
+                    c = n;
+                    if fam.rolls() {
+                        pose = pp.clone();
+                        samples = ss.to_vec();
+                    }
+                    improved = true;
+                }
+            }
+            if !improved {
+                for s in step.iter_mut() {
+                    *s *= 0.5;
+                }
+                if step[0] < 0.25 {
+                    break;
+                }
+            }
+        }
+        (best, c)
+    }
+
+    /// Commit a placement: its pixels are covered, and it owns them and those near it.
+    pub fn commit(&mut self, p: Placement, family: Family) {
+        let pose = family.pose(p.alpha);
+        self.draw(self.placements.len(), &p, &pose);
+        self.heights
+            .push((self.frame.height(p.m), pose.half_height));
+        self.families.push(family);
+        self.placements.push(p);
+    }
+
+    /// Redraw the value and owner maps from every placement but `skip`.
+    fn redraw(&mut self, skip: Option<usize>) {
+        self.value = self
+            .picture
+            .on
+            .iter()
+            .map(|&b| if b { 1.0 } else { -1.0 })
+            .collect();
+        self.owners.iter_mut().for_each(|o| *o = 0);
+        for k in 0..self.placements.len() {
+            if Some(k) != skip {
+                let p = self.placements[k].clone();
+                let pose = self.families[k].pose(p.alpha);
+                self.draw(k, &p, &pose);
+            }
+        }
+    }
+
+    /// Undo the greedy's short sight: `rounds` times, each placement in turn is lifted
+    /// off and refined (pattern search from where it is) against all the others. An
+    /// early placement can then give up what a later one covers better (a wide shadow
+    /// over a junction, say). A placement's height rule is kept against the others.
+    pub fn polish(&mut self, rounds: usize) {
+        for _ in 0..rounds {
+            for k in 0..self.placements.len() {
+                self.redraw(Some(k));
+                let p = self.placements[k].clone();
+                let heights = std::mem::take(&mut self.heights);
+                // The placement's own height is not a constraint on itself.
+                self.heights = heights.clone();
+                self.heights[k] = (f64::NAN, 0.0);
+                let c = Candidate {
+                    centre: p.centre,
+                    theta: p.theta,
+                    m: p.m,
+                    alpha: p.alpha,
+                };
+                let (gain, c) = self.refine(&self.families[k].clone(), c);
+                self.heights = heights;
+                if gain.is_finite() {
+                    let pose = self.families[k].pose(c.alpha);
+                    let scale = c.m / self.frame.metres_per_px;
+                    self.placements[k] = Placement {
+                        alpha: c.alpha,
+                        centre: c.centre,
+                        theta: c.theta,
+                        m: c.m,
+                        gain,
+                        area: pose.outline.area() * scale * scale,
+                        ..p
+                    };
+                    self.heights[k] = (self.frame.height(c.m), pose.half_height);
+                }
+            }
+        }
+        self.redraw(None);
+    }
+
+    fn draw(&mut self, index: usize, p: &Placement, pose: &Pose) {
+        let (w, h) = (self.picture.width, self.picture.height);
+        let scale = p.m / self.frame.metres_per_px;
+        let near = (NEAR_M * scale).ceil();
+        let e = pose.outline.half_extents();
+        let reach = scale * e.length() + near + 1.0;
+        let (x0, x1) = (
+            (p.centre.x - reach).floor().max(0.0) as usize,
+            ((p.centre.x + reach).ceil() as usize).min(w),
+        );
+        let (y0, y1) = (
+            (p.centre.y - reach).floor().max(0.0) as usize,
+            ((p.centre.y + reach).ceil() as usize).min(h),
+        );
+        let bit = 1u64 << (index % 64);
+        let rings: Vec<DVec2> = (0..8)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::FRAC_PI_4;
+                DVec2::new(a.cos(), a.sin()) * (near / scale)
+            })
+            .collect();
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let d = from_pixel(
+                    p.centre,
+                    p.theta,
+                    scale,
+                    DVec2::new(x as f64 + 0.5, y as f64 + 0.5),
+                );
+                let k = y * w + x;
+                if pose.outline.contains(d) {
+                    self.value[k] = 0.0;
+                    self.owners[k] |= bit;
+                } else if rings.iter().any(|r| pose.outline.contains(d + *r)) {
+                    self.owners[k] |= bit;
+                }
+            }
         }
     }
 }
 
-/// The pixel whose square of half-side `half` holds the most target.
-fn densest(target: &Mask, half: usize) -> Option<(usize, usize)> {
-    let (w, h) = (target.width(), target.height());
-    let all: Vec<u32> = (0..w * h)
-        .map(|k| u32::from(target.get(k % w, k / w)))
-        .collect();
-    let mut sums = vec![0u32; (w + 1) * (h + 1)];
-    integrate(&all, w, h, &mut sums);
-    let at = |x: usize, y: usize| sums[y * (w + 1) + x];
-    (0..w * h).map(|k| (k % w, k / w)).max_by_key(|&(x, y)| {
-        let (x0, y0) = (x.saturating_sub(half), y.saturating_sub(half));
-        let (x1, y1) = ((x + half + 1).min(w), (y + half + 1).min(h));
-        at(x1, y1) + at(x0, y0) - at(x0, y1) - at(x1, y0)
-    })
+/// Keep the best [`KEEP`] candidates, at most one per nearby centre.
+fn keep(kept: &mut Vec<(f64, usize, Candidate)>, c: (f64, usize, Candidate)) {
+    if kept.len() == KEEP && c.0 <= kept[KEEP - 1].0 {
+        return;
+    }
+    if let Some(k) = kept
+        .iter()
+        .position(|k| k.1 == c.1 && k.2.centre.distance(c.2.centre) < 8.0)
+    {
+        if kept[k].0 >= c.0 {
+            return;
+        }
+        kept.remove(k);
+    }
+    let at = kept.iter().position(|k| k.0 < c.0).unwrap_or(kept.len());
+    kept.insert(at, c);
+    kept.truncate(KEEP);
+}
+
+/// Keep one ridge pixel (the one farthest inside) per `cell` x `cell` block.
+fn thin(ridge: &mut Vec<(usize, usize)>, dist: &[f32], width: usize, cell: usize) {
+    let mut best: std::collections::HashMap<(usize, usize), (usize, usize)> = Default::default();
+    for &(x, y) in ridge.iter() {
+        let key = (x / cell, y / cell);
+        let e = best.entry(key).or_insert((x, y));
+        if dist[y * width + x] > dist[e.1 * width + e.0] {
+            *e = (x, y);
+        }
+    }
+    let mut out: Vec<(usize, usize)> = best.into_values().collect();
+    out.sort_unstable();
+    *ridge = out;
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::design::pose::families;
+    use crate::geometry::shape::Shape;
+    use glam::DVec3;
+
+    /// A picture of axis-aligned rectangles (x0, y0, x1, y1) in pixels.
+    fn picture(w: usize, h: usize, rects: &[(usize, usize, usize, usize)]) -> Picture {
+        let on = (0..w * h)
+            .map(|k| {
+                let (x, y) = (k % w, k / w);
+                rects
+                    .iter()
+                    .any(|r| (r.0..r.2).contains(&x) && (r.1..r.3).contains(&y))
+            })
+            .collect();
+        Picture::new(w, h, on)
+    }
+
+    fn block() -> Vec<Family> {
+        families(&Shape::Cuboid {
+            half_extents: DVec3::new(0.07, 0.035, 0.0175),
+        })
+    }
 
     #[test]
-    fn summed_area_table_counts_a_rectangle() {
-        let (w, h) = (5, 4);
-        let v: Vec<u32> = (0..w * h).map(|k| (k % 3 == 0) as u32).collect();
-        let mut s = vec![0u32; (w + 1) * (h + 1)];
-        integrate(&v, w, h, &mut s);
-        let direct: u32 = (1..3)
-            .flat_map(|y| (2..5).map(move |x| (x, y)))
-            .map(|(x, y)| v[y * w + x])
-            .sum();
-        let at = |x: usize, y: usize| s[y * (w + 1) + x];
-        assert_eq!(at(5, 3) + at(2, 1) - at(2, 3) - at(5, 1), direct);
+    fn a_block_goes_along_a_bar_at_the_magnification_of_its_length() {
+        // A vertical bar 60 x 200 px at 2.5 mm per pixel under a light 6 m up: a
+        // 0.14 m block covers its length at m = 200 * 0.0025 / 0.14 = 3.57.
+        let pic = picture(320, 240, &[(130, 20, 190, 220)]);
+        let cover = Cover::new(&pic, Frame::new(0.0025, 6.0));
+        let p = cover.best(0, &block()).unwrap();
+        let along = (p.theta.rem_euclid(std::f64::consts::PI) - std::f64::consts::FRAC_PI_2).abs();
+        assert!(along < 0.05, "theta {}", p.theta);
+        // Within the sample quadrature's reach (a few pixels at each end).
+        assert!((p.m - 3.57).abs() < 0.3, "m {}", p.m);
+        // On the bar's centre line, both ends within the bar.
+        let half = 0.07 * p.m / 0.0025;
+        assert!((p.centre.x - 160.0).abs() < 2.0, "{}", p.centre);
+        assert!(
+            p.centre.y - half > 17.0 && p.centre.y + half < 223.0,
+            "{}",
+            p.centre
+        );
+        assert!(p.gain > 0.9 * 12000.0, "gain {}", p.gain);
+    }
+
+    #[test]
+    fn touching_shadows_fly_apart_in_height() {
+        // A cross of two bars: two blocks, one per bar, their heights at least the
+        // separation apart; and polishing keeps that.
+        let pic = picture(320, 240, &[(40, 100, 280, 140), (140, 10, 180, 230)]);
+        let frame = Frame::new(0.0025, 6.0);
+        let mut cover = Cover::new(&pic, frame);
+        for k in 0..2 {
+            let fams = block();
+            let p = cover.best(k, &fams).unwrap();
+            let f = fams[p.family].clone();
+            cover.commit(p, f);
+        }
+        cover.polish(1);
+        let [a, b] = [&cover.placements[0], &cover.placements[1]];
+        let pose = |p: &Placement| block()[p.family].pose(p.alpha);
+        let need = separation(pose(a).half_height, pose(b).half_height);
+        assert!((frame.height(a.m) - frame.height(b.m)).abs() >= need - 1e-9);
+        // One bar each: their angles differ by a right angle.
+        let d = (a.theta - b.theta).rem_euclid(std::f64::consts::PI);
+        assert!(
+            (d - std::f64::consts::FRAC_PI_2).abs() < 0.1,
+            "{} {}",
+            a.theta,
+            b.theta
+        );
+        assert!(cover.open() < 2000, "{} target pixels left", cover.open());
+    }
+
+    #[test]
+    fn pixels_and_outline_coordinates_are_inverse() {
+        let c = DVec2::new(100.0, 50.0);
+        for theta in [0.0, 0.4, 2.0] {
+            let d = DVec2::new(0.03, -0.01);
+            let p = to_pixel(c, theta, 400.0, d);
+            assert!(from_pixel(c, theta, 400.0, p).distance(d) < 1e-12);
+        }
+        // Outline x at theta = 90 degrees points up the image (decreasing pixel y).
+        let p = to_pixel(c, std::f64::consts::FRAC_PI_2, 100.0, DVec2::new(0.1, 0.0));
+        assert!(p.distance(DVec2::new(100.0, 40.0)) < 1e-9);
     }
 }

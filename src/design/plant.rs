@@ -63,6 +63,9 @@ pub enum PlantError {
         #[source]
         source: ObjError,
     },
+    /// A chess piece by name (only `bsa new` writes the built-in set's meshes).
+    #[error("chess:{piece}: bsa plant takes the chess pieces as meshes (mesh:scenes/thinker/pieces/{piece}.obj)")]
+    Chess { piece: String },
     /// No draw met the conditions.
     #[error("no launch in {attempts} draws keeps these {objects} objects clear of each other with every shadow inside the picture and visible: the inventory does not fit in a {width} m picture (use fewer or smaller objects, or a wider picture)")]
     NoFit {
@@ -105,6 +108,11 @@ impl Layout {
                     0.5 * size[2],
                     "box".to_string(),
                 ),
+                Kind::Chess { piece } => {
+                    return Err(PlantError::Chess {
+                        piece: piece.clone(),
+                    })
+                }
                 Kind::Mesh { obj, scale } => {
                     let mesh = load_obj(obj, *scale).map_err(|source| PlantError::Mesh {
                         path: obj.display().to_string(),

@@ -213,6 +213,15 @@ fn new_refuses_pictures_objects_and_options_it_cannot_use() {
         (m, "cube:1", vec![], "unknown kind `cube`"),
         (
             m,
+            "mesh:/nonexistent/piece.obj",
+            vec![],
+            "/nonexistent/piece.obj",
+        ),
+        (m, "chess:emperor", vec![], "unknown chess piece `emperor`"),
+        (m, "auto:sphere,auto:chess", vec![], "at most one auto"),
+        (m, "sphere:0.1", vec!["--t", "0"], "--t"),
+        (
+            m,
             "sphere:0.1",
             vec!["--light-height", "-1"],
             "--light-height",
@@ -236,4 +245,94 @@ fn new_refuses_pictures_objects_and_options_it_cannot_use() {
             "{objects}: expected `{expect}` in: {err}"
         );
     }
+}
+
+/// A 160 x 120 picture of two bars (a T), black on white.
+fn two_bars(path: &Path) {
+    image::GrayImage::from_fn(160, 120, |x, y| {
+        let bar = (30..130).contains(&x) && (20..34).contains(&y);
+        let stem = (73..87).contains(&x) && (20..100).contains(&y);
+        image::Luma([if bar || stem { 0 } else { 255 }])
+    })
+    .save(path)
+    .unwrap();
+}
+
+#[test]
+fn new_lays_blocks_along_strokes_with_two_hints_and_a_contact_free_start() {
+    let d = tmpdir("new-blocks");
+    let target = d.join("t.png");
+    two_bars(&target);
+    let dir = d.join("t");
+    let (ok, out, err) = bsa(&[
+        "new",
+        dir.to_str().unwrap(),
+        "--target",
+        target.to_str().unwrap(),
+        "--objects",
+        "box:0.14x0.035x0.035*2",
+        "--width",
+        "0.8",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("no contact before t"), "{out}");
+    let iou: f64 = out
+        .split("start guess IoU ")
+        .nth(1)
+        .and_then(|s| s.split(',').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(iou > 0.6, "{out}");
+    let scene: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("scene.json")).unwrap()).unwrap();
+    // Elongated blocks get both ends as hints; every start guess is explicit.
+    assert_eq!(scene["hints"].as_array().unwrap().len(), 4);
+    for o in scene["occluders"].as_array().unwrap() {
+        assert!(o["start_velocity"].is_array() && o["start_angular_velocity"].is_array());
+    }
+    let (ok, check, err) = bsa(&["check", dir.to_str().unwrap()]);
+    assert!(ok && check.contains("no contact before t"), "{check}{err}");
+}
+
+#[test]
+fn new_reads_a_json_list_chess_pieces_and_chooses_a_count() {
+    let d = tmpdir("new-json");
+    let target = d.join("t.png");
+    two_bars(&target);
+    let list = d.join("objects.json");
+    std::fs::write(
+        &list,
+        r#"[{"kind": "chess", "piece": "pawn", "count": 2}, {"kind": "box", "size": [0.05, 0.02, 0.02], "count": "auto"}]"#,
+    )
+    .unwrap();
+    let dir = d.join("j");
+    let args = |objects: &str| {
+        vec![
+            "new".to_string(),
+            dir.to_str().unwrap().to_string(),
+            "--target".into(),
+            target.to_str().unwrap().into(),
+            "--objects".into(),
+            objects.into(),
+            "--width".into(),
+            "0.4".into(),
+            "--light-height".into(),
+            "3".into(),
+        ]
+    };
+    let run = |a: Vec<String>| bsa(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let (ok, out, err) = run(args(list.to_str().unwrap()));
+    assert!(ok, "{err}");
+    assert!(dir.join("pieces/pawn.obj").is_file());
+    let chosen: usize = out
+        .split(" objects (")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(chosen >= 1, "{out}");
+    // A JSON list's errors name the entry and the field.
+    std::fs::write(&list, r#"[{"kind": "box", "size": [0.1, 0.1]}]"#).unwrap();
+    let (ok, _, err) = run(args(list.to_str().unwrap()));
+    assert!(!ok && err.contains("objects[0].size"), "{err}");
 }

@@ -1,0 +1,286 @@
+//! The held-out test pictures of `bsa new` (issue "bsa new"): letters and digits of
+//! DejaVu Sans (the font in `assets/fonts/`, emboldened by a dilation so that strokes
+//! are about as wide as a wooden block's shadow), simple shapes and three silhouettes
+//! (DejaVu Sans's airplane, chess knight and umbrella symbols), 640 x 480, black on
+//! white, each with the box of objects it is to be made of, stated before any solve.
+//!
+//! Run: `cargo run --release --example test_pictures [-- DIR]` (default
+//! `tools/test-pictures`): writes `DIR/<name>.png` and `DIR/manifest.tsv` (name,
+//! objects, extra `bsa new` options), which `scripts/new-suite.sh` reads. The output
+//! depends only on the font file and this code.
+
+use std::error::Error;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use ab_glyph::{Font, FontRef, PxScale};
+
+const W: usize = 640;
+const H: usize = 480;
+/// The shape's bounding box fills at most this share of the frame's height and width.
+const FILL_H: f64 = 0.7;
+const FILL_W: f64 = 0.8;
+/// Supersampling of the drawn shapes (per axis).
+const SS: usize = 4;
+
+/// Maple unit blocks (Caroline Pratt's system, docs/results.md).
+const UNIT: &str = "box:0.1397x0.06985x0.0349";
+const DOUBLE: &str = "box:0.2794x0.06985x0.0349";
+const HALF: &str = "box:0.06985x0.06985x0.0349";
+const PILLAR: &str = "box:0.1397x0.0349x0.0349";
+
+/// What a picture shows.
+enum Shape {
+    /// A character of the font, dilated by this many pixels.
+    Glyph(char, usize),
+    /// A point-set drawn by supersampling: true inside, in coordinates centred on the
+    /// frame with y up (pixels).
+    Drawn(fn(f64, f64) -> bool),
+}
+
+fn ring(x: f64, y: f64) -> bool {
+    let r = x.hypot(y);
+    (100.0..=160.0).contains(&r)
+}
+
+fn arrow(x: f64, y: f64) -> bool {
+    // A shaft 200 x 60 and a head 150 wide at its base, pointing right.
+    let shaft = (-220.0..=20.0).contains(&x) && y.abs() <= 30.0;
+    let head = (20.0..=170.0).contains(&x) && y.abs() <= 75.0 * (170.0 - x) / 150.0;
+    shaft || head
+}
+
+fn crescent(x: f64, y: f64) -> bool {
+    x.hypot(y) <= 160.0 && (x - 70.0).hypot(y - 30.0) > 130.0
+}
+
+fn cross(x: f64, y: f64) -> bool {
+    (x.abs() <= 35.0 && y.abs() <= 160.0) || (y.abs() <= 35.0 && x.abs() <= 160.0)
+}
+
+/// name, shape, objects, extra `bsa new` options.
+fn pictures() -> Vec<(&'static str, Shape, String, &'static str)> {
+    let chess_stage = "--width 0.96 --light-height 3";
+    vec![
+        (
+            "letter-a",
+            Shape::Glyph('A', 6),
+            format!("{DOUBLE}*2,{UNIT}*2"),
+            "",
+        ),
+        (
+            "letter-k",
+            Shape::Glyph('K', 6),
+            format!("{DOUBLE}*2,{UNIT}*2"),
+            "",
+        ),
+        (
+            "letter-r",
+            Shape::Glyph('R', 6),
+            format!("{DOUBLE},{UNIT}*4,{HALF}*2"),
+            "",
+        ),
+        (
+            "letter-e",
+            Shape::Glyph('e', 6),
+            format!("{UNIT}*6,{HALF}*2"),
+            "",
+        ),
+        (
+            "digit-2",
+            Shape::Glyph('2', 6),
+            format!("{UNIT}*5,{HALF}*2"),
+            "",
+        ),
+        (
+            "digit-4",
+            Shape::Glyph('4', 6),
+            format!("{DOUBLE}*2,{UNIT}*2"),
+            "",
+        ),
+        (
+            "digit-7",
+            Shape::Glyph('7', 6),
+            format!("{DOUBLE},{UNIT}*2"),
+            "",
+        ),
+        (
+            "ring",
+            Shape::Drawn(ring),
+            format!("{UNIT}*8,{PILLAR}*4"),
+            "",
+        ),
+        (
+            "arrow",
+            Shape::Drawn(arrow),
+            format!("{DOUBLE},{UNIT}*3,{HALF}*3"),
+            "",
+        ),
+        (
+            "crescent",
+            Shape::Drawn(crescent),
+            "sphere:0.09*3,sphere:0.06*4".to_string(),
+            "",
+        ),
+        (
+            "cross",
+            Shape::Drawn(cross),
+            format!("{DOUBLE}*2,{HALF}*2"),
+            "",
+        ),
+        (
+            "airplane",
+            Shape::Glyph('\u{2708}', 0),
+            "chess".to_string(),
+            chess_stage,
+        ),
+        (
+            "knight",
+            Shape::Glyph('\u{265E}', 0),
+            "chess".to_string(),
+            chess_stage,
+        ),
+        (
+            "umbrella",
+            Shape::Glyph('\u{2602}', 0),
+            "chess".to_string(),
+            chess_stage,
+        ),
+    ]
+}
+
+/// Coverage of a glyph at `scale`, drawn with its top-left at `at` into a `W x H` grid.
+fn draw_glyph(
+    font: &FontRef,
+    c: char,
+    scale: f32,
+    at: (f32, f32),
+) -> Result<Vec<f32>, Box<dyn Error>> {
+    let id = font.glyph_id(c);
+    if id.0 == 0 {
+        return Err(format!("the font has no glyph for {c:?}").into());
+    }
+    let glyph = id.with_scale_and_position(PxScale::from(scale), ab_glyph::point(at.0, at.1));
+    let outline = font.outline_glyph(glyph).ok_or("glyph without outline")?;
+    let b = outline.px_bounds();
+    let mut cov = vec![0.0f32; W * H];
+    outline.draw(|x, y, v| {
+        let (px, py) = (b.min.x as i64 + x as i64, b.min.y as i64 + y as i64);
+        if px >= 0 && py >= 0 && (px as usize) < W && (py as usize) < H {
+            cov[py as usize * W + px as usize] = v;
+        }
+    });
+    Ok(cov)
+}
+
+fn bounds(on: &[bool]) -> Option<(usize, usize, usize, usize)> {
+    let (mut x0, mut y0, mut x1, mut y1) = (W, H, 0, 0);
+    for (k, _) in on.iter().enumerate().filter(|(_, &b)| b) {
+        let (x, y) = (k % W, k / W);
+        (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x + 1), y1.max(y + 1));
+    }
+    (x1 > x0).then_some((x0, y0, x1, y1))
+}
+
+fn glyph(font: &FontRef, c: char, dilate: usize) -> Result<Vec<bool>, Box<dyn Error>> {
+    // Measure at a trial size, then scale the ink box to the frame and centre it.
+    let trial = 200.0f32;
+    let at = (200.0, 300.0);
+    let on: Vec<bool> = draw_glyph(font, c, trial, at)?
+        .iter()
+        .map(|&v| v >= 0.5)
+        .collect();
+    let (x0, y0, x1, y1) = bounds(&on).ok_or("empty glyph")?;
+    let (bw, bh) = ((x1 - x0) as f64, (y1 - y0) as f64);
+    let grow = 2.0 * dilate as f64;
+    let f = ((FILL_H * H as f64 - grow) / bh).min((FILL_W * W as f64 - grow) / bw);
+    let scale = trial * f as f32;
+    // The ink box's centre moves with the scale about the pen position.
+    let cx = at.0 as f64 + ((x0 + x1) as f64 / 2.0 - at.0 as f64) * f;
+    let cy = at.1 as f64 + ((y0 + y1) as f64 / 2.0 - at.1 as f64) * f;
+    let pen = (
+        (at.0 as f64 + W as f64 / 2.0 - cx) as f32,
+        (at.1 as f64 + H as f64 / 2.0 - cy) as f32,
+    );
+    let on: Vec<bool> = draw_glyph(font, c, scale, pen)?
+        .iter()
+        .map(|&v| v >= 0.5)
+        .collect();
+    Ok(dilated(&on, dilate))
+}
+
+/// Dilation by a disc of radius `r` pixels.
+fn dilated(on: &[bool], r: usize) -> Vec<bool> {
+    if r == 0 {
+        return on.to_vec();
+    }
+    let ri = r as i64;
+    let mut out = vec![false; W * H];
+    for (k, _) in on.iter().enumerate().filter(|(_, &b)| b) {
+        let (x, y) = ((k % W) as i64, (k / W) as i64);
+        for dy in -ri..=ri {
+            for dx in -ri..=ri {
+                let (px, py) = (x + dx, y + dy);
+                if dx * dx + dy * dy <= ri * ri
+                    && px >= 0
+                    && py >= 0
+                    && px < W as i64
+                    && py < H as i64
+                {
+                    out[py as usize * W + px as usize] = true;
+                }
+            }
+        }
+    }
+    out
+}
+
+fn drawn(f: fn(f64, f64) -> bool) -> Vec<bool> {
+    (0..W * H)
+        .map(|k| {
+            let (x, y) = ((k % W) as f64, (k / W) as f64);
+            let mut n = 0;
+            for j in 0..SS {
+                for i in 0..SS {
+                    let px = x + (i as f64 + 0.5) / SS as f64 - W as f64 / 2.0;
+                    let py = H as f64 / 2.0 - (y + (j as f64 + 0.5) / SS as f64);
+                    n += usize::from(f(px, py));
+                }
+            }
+            2 * n >= SS * SS
+        })
+        .collect()
+}
+
+fn main() -> Result<(), Box<dyn Error>> {
+    let dir = std::env::args()
+        .nth(1)
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tools/test-pictures"));
+    std::fs::create_dir_all(&dir)?;
+    let font = FontRef::try_from_slice(include_bytes!("../assets/fonts/DejaVuSans.ttf"))?;
+    let mut manifest =
+        String::from("# name\tobjects\toptions (bsa new; written by examples/test_pictures.rs)\n");
+    for (name, shape, objects, options) in pictures() {
+        let on = match shape {
+            Shape::Glyph(c, d) => glyph(&font, c, d)?,
+            Shape::Drawn(f) => drawn(f),
+        };
+        let img = image::GrayImage::from_fn(W as u32, H as u32, |x, y| {
+            image::Luma([if on[y as usize * W + x as usize] {
+                0
+            } else {
+                255
+            }])
+        });
+        img.save(dir.join(format!("{name}.png")))?;
+        writeln!(manifest, "{name}\t{objects}\t{options}")?;
+        println!(
+            "{name}: {} shadow pixels",
+            on.iter().filter(|&&b| b).count()
+        );
+    }
+    std::fs::write(dir.join("manifest.tsv"), manifest)?;
+    println!("wrote {}", dir.display());
+    Ok(())
+}

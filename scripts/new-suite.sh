@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# The held-out pictures of `bsa new`: for every picture of tools/test-pictures/manifest.tsv
+# (made by `cargo run --release --example test_pictures`, each with its box of objects
+# stated there before any solve), `bsa new` then `bsa solve`, no edits in between, and a
+# table: picture, objects, start IoU, final IoU, contacts before t, wall time (new + solve,
+# whole processes). The overlays are tiled into docs/images/new-suite[-auto].png.
+#
+#     bash scripts/new-suite.sh [SEED] [auto]      # defaults: seed 1, the stated boxes
+#
+# With `auto`, every picture gets one automatic item of its kind instead (auto:box of the
+# unit block for the block pictures, auto:sphere for the sphere one, auto:chess for the
+# chess ones) and the table gives the count chosen.
+# Scenes and solves go to /tmp/bsa-new-suite[-auto]/<picture>/ and <picture>-out/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seed=${1:-1}
+mode=${2:-given}
+cargo build --release --locked --quiet --bin bsa --example contact_sheet
+bsa=$(cargo metadata --format-version 1 --no-deps | python3 -c 'import json,sys; print(json.load(sys.stdin)["target_directory"])')/release
+sheet=$bsa/examples/contact_sheet
+bsa=$bsa/bsa
+pics=tools/test-pictures
+root=/tmp/bsa-new-suite
+suffix=""
+if [ "$mode" = auto ]; then root=/tmp/bsa-new-suite-auto; suffix=-auto; fi
+mkdir -p "$root"
+rows=$root/results.tsv
+: >"$rows"
+overlays=()
+while IFS=$'\t' read -r name objects options; do
+    case "$name" in '#'*|'') continue ;; esac
+    if [ "$mode" = auto ]; then
+        case "$objects" in
+            chess*) objects=auto:chess ;;
+            sphere*) objects=auto:sphere ;;
+            *) objects=auto:box:0.1397x0.06985x0.0349 ;;
+        esac
+    fi
+    dir=$root/$name
+    rm -rf "$dir" "$dir-out"
+    t0=$(date +%s.%N)
+    # shellcheck disable=SC2086
+    new=$("$bsa" new "$dir" --target "$pics/$name.png" --objects "$objects" --seed "$seed" $options)
+    "$bsa" solve "$dir" -q --seed "$seed" --out "$dir-out" >"$dir-out.log"
+    t1=$(date +%s.%N)
+    start=$(sed -n 's/.*start guess IoU \([0-9.]*\).*/\1/p' <<<"$new")
+    count=$(sed -n 's/^[^:]*: \([0-9]*\) objects.*/\1/p' <<<"$new")
+    python3 - "$dir-out/solution.json" "$name" "$objects" "$count" "$start" "$t0" "$t1" >>"$rows" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+name, objects, count, start, t0, t1 = sys.argv[2:8]
+print("\t".join([name, objects, count, start, f"{s['iou']:.4f}", str(s["n_contacts"]),
+                 f"{float(t1) - float(t0):.1f}"]))
+PY
+    tail -n 1 "$rows"
+    overlays+=("$dir-out/overlay.png")
+done <"$pics/manifest.tsv"
+python3 - "$rows" <<'PY'
+import statistics, sys
+rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
+print()
+print("| picture | objects | count | start IoU | final IoU | contacts before t | wall time (s) |")
+print("|---|---|---|---|---|---|---|")
+for r in rows:
+    print("| " + " | ".join(r) + " |")
+ious = [float(r[4]) for r in rows]
+print()
+print(f"final IoU: median {statistics.median(ious):.4f}, min {min(ious):.4f}, "
+      f">= 0.90: {sum(i >= 0.90 for i in ious)} of {len(ious)}; "
+      f"solves with a contact: {sum(r[5] != '0' for r in rows)}; "
+      f"start IoU median {statistics.median(float(r[3]) for r in rows):.4f}")
+PY
+"$sheet" "docs/images/new-suite$suffix.png" 4 320 "${overlays[@]}"
