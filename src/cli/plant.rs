@@ -101,7 +101,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let placeholder = Mask::from_fn(w, h, |x, y| x == w / 2 && y == h / 2);
     write_target(dir, &placeholder)?;
     let scene_file = dir.join("scene.json");
-    let write_scene = |hints: &[(usize, glam::DVec2)]| -> Result<()> {
+    let write_scene = |hints: &[(usize, glam::DVec3, glam::DVec2)]| -> Result<()> {
         let json = layout.scene_json(&name, "target.png", hints, opts.seed);
         files::write_atomic(&scene_file, serde_json::to_string_pretty(&json)?.as_bytes())?;
         Ok(())

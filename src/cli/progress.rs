@@ -116,8 +116,14 @@ impl Observer for SolveProgress {
             // Each restart runs up to the stage's iteration cap again.
             bar.set_length(bar.length().unwrap_or(0) + self.run_length);
             let prefix = bar.prefix();
-            let base = prefix.split(" (restart").next().unwrap_or(&prefix).to_string();
-            bar.set_prefix(format!("{base} (restart {restart}, population {population})"));
+            let base = prefix
+                .split(" (restart")
+                .next()
+                .unwrap_or(&prefix)
+                .to_string();
+            bar.set_prefix(format!(
+                "{base} (restart {restart}, population {population})"
+            ));
         }
     }
 

@@ -186,12 +186,13 @@ impl Layout {
     }
 
     /// The scene file: geometry, the objects, the target file `target`, `hints` as
-    /// (occluder index, pixel) pairs, and the default strategy for this many objects.
+    /// (occluder index, point in the body's frame, pixel), and the default strategy for
+    /// this many objects.
     pub fn scene_json(
         &self,
         name: &str,
         target: &str,
-        hints: &[(usize, DVec2)],
+        hints: &[(usize, DVec3, DVec2)],
         seed: u64,
     ) -> Value {
         let s = &self.stage;
@@ -204,8 +205,8 @@ impl Layout {
             .collect();
         let hints: Vec<Value> = hints
             .iter()
-            .map(|(i, px)| {
-                json!({"occluder": self.objects[*i].0, "point": [0.0, 0.0, 0.0], "pixel": [px.x, px.y]})
+            .map(|(i, p, px)| {
+                json!({"occluder": self.objects[*i].0, "point": [p.x, p.y, p.z], "pixel": [px.x, px.y]})
             })
             .collect();
         let mut scene = json!({
@@ -312,8 +313,8 @@ pub fn draw_launch(problem: &Problem, seed: u64, attempts: usize) -> Result<Vec<
 /// volume); while some blob has no object, the largest object left takes the largest
 /// blob left, so that every blob is covered; the objects beyond take, in turn, the
 /// blob with the most area per object already on it. A hint sends the object's centre
-/// to its blob's centroid.
-pub fn hints(problem: &Problem, target: &Mask) -> Vec<(usize, DVec2)> {
+/// of mass (its point, in the body's frame) to its blob's centroid.
+pub fn hints(problem: &Problem, target: &Mask) -> Vec<(usize, DVec3, DVec2)> {
     let mut blobs = target.blobs();
     if blobs.is_empty() {
         return Vec::new();
@@ -342,7 +343,7 @@ pub fn hints(problem: &Problem, target: &Mask) -> Vec<(usize, DVec2)> {
                 .expect("at least one blob")
         };
         taken[k] += 1;
-        out.push((i, blobs[k].1));
+        out.push((i, occ[i].mass.local_com, blobs[k].1));
     }
     out.sort_by_key(|h| h.0);
     out

@@ -19,7 +19,62 @@ fn fingerprint(e: &Evaluation, ws: &Workspace) -> (Vec<u64>, Outcome, Mask, Vec<
             v.map(f64::to_bits)
         })
         .collect();
-    (bits, e.outcome, ws.mask.clone(), poses)
+    // `own_contact` differs by design: a held evaluation counts only the contacts of
+    // the bodies it varies (see `own_contact_counts_only_what_a_stage_can_change`).
+    let outcome = Outcome {
+        own_contact: 0.0,
+        ..e.outcome
+    };
+    (bits, outcome, ws.mask.clone(), poses)
+}
+
+/// Fly's start guess with its first two blocks sent into each other: both launched
+/// straight at the other's launch point, they meet within 0.1 s.
+fn fly_with_a_collision() -> (Problem, Vec<f64>) {
+    let p = scene("fly");
+    let mut params = p.scene.start_parameters();
+    let (a, b) = (
+        p.scene.occluders[0].launch_com(),
+        p.scene.occluders[1].launch_com(),
+    );
+    for (i, from, to) in [(0, a, b), (1, b, a)] {
+        let mut l = Launch::get(&params, i);
+        l.velocity = (to - from) / 0.2 + DVec3::new(0.0, 0.0, 1.0);
+        l.set(&mut params, i);
+    }
+    (p, params)
+}
+
+#[test]
+fn own_contact_counts_only_what_a_stage_can_change() {
+    let (p, params) = fly_with_a_collision();
+    let w = Weights::all_ones();
+    let mut ws = p.workspace();
+    let full = p.evaluate(&params, &w, &mut ws);
+    assert!(
+        full.outcome.n_contacts > 0 && full.outcome.t_sim < 0.2,
+        "{full:?}"
+    );
+    assert_eq!(full.outcome.own_contact, full.raw[Term::Contact as usize]);
+    // A stage that varies a third block: the collision of two held blocks is not its own.
+    let held = p.hold(&params, &[3]);
+    let e = p.evaluate_held(&held, &params, &w, &mut ws);
+    assert_eq!(
+        e.outcome.t_sim, full.outcome.t_sim,
+        "the reports still see it"
+    );
+    assert_eq!(e.outcome.own_contact, 0.0);
+    // A stage that varies one of the two: its own.
+    let mut held = p.hold(&params, &[0]);
+    let e = p.evaluate_held(&held, &params, &w, &mut ws);
+    assert!(e.outcome.own_contact >= p.scene.t - 0.2, "{e:?}");
+    // ... unless the other is still at its start guess (not placed yet).
+    let mut unplaced = vec![false; p.scene.occluders.len()];
+    unplaced[1] = true;
+    held.ignore_contacts_with(&unplaced);
+    let e = p.evaluate_held(&held, &params, &w, &mut ws);
+    assert_eq!(e.outcome.t_sim, full.outcome.t_sim);
+    assert!(e.outcome.own_contact < full.outcome.own_contact, "{e:?}");
 }
 
 #[test]

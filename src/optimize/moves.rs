@@ -23,8 +23,8 @@
 use glam::DVec3;
 
 use crate::energy::{Term, Weights, DIVERGED_ENERGY};
-use crate::geometry::shape::Shape;
 use crate::evaluate::{Evaluation, Held, Problem, Workspace};
+use crate::geometry::shape::Shape;
 use crate::scene::Launch;
 
 /// Fraction of the light-to-receiver distance (along a line of sight) that a moved body's
@@ -72,7 +72,7 @@ pub struct MoveReport {
 /// occluder), whose evaluation is `best`: at most `max_moves` moves are taken, each the
 /// best-ranked candidate of a pass when it ranks better than the current launch.
 /// `params` and `best` are updated in place; `held` is the stage's (it holds only
-/// occluders not in `vary`).
+/// occluders not in `vary`); `record` sees every candidate's evaluation.
 #[allow(clippy::too_many_arguments)]
 pub fn improve(
     problem: &Problem,
@@ -84,6 +84,7 @@ pub fn improve(
     best: &mut Evaluation,
     max_moves: usize,
     ws: &mut Workspace,
+    record: &mut dyn FnMut(&Evaluation),
 ) -> MoveReport {
     let scene = &problem.scene;
     let movable: Vec<usize> = vary
@@ -114,6 +115,7 @@ pub fn improve(
         let mut consider = |candidate: &[f64], report: &mut MoveReport, ws: &mut Workspace| {
             let e = problem.evaluate_held(held, candidate, weights, ws);
             report.samples += 1;
+            record(&e);
             if e.outcome.own_contact > 0.0
                 && e.total < DIVERGED_ENERGY
                 && promising.as_ref().is_none_or(|p| free(&e) < p.0)
@@ -215,7 +217,14 @@ fn sights(problem: &Problem, movable: &[usize], ws: &mut Workspace) -> Vec<Optio
 /// Set body `i`'s launch velocity in `params` so that its centre of mass is at `t` on
 /// the light's line through `on_receiver`, at the depth where its shadow (now `own`)
 /// has `area` pixels: the shadow's size goes as the inverse of the depth.
-fn send(problem: &Problem, params: &mut [f64], i: usize, on_receiver: DVec3, own: Sight, area: f64) {
+fn send(
+    problem: &Problem,
+    params: &mut [f64],
+    i: usize,
+    on_receiver: DVec3,
+    own: Sight,
+    area: f64,
+) {
     let scene = &problem.scene;
     let o = &scene.occluders[i];
     let light = scene.camera.light;

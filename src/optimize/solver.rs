@@ -293,6 +293,14 @@ pub fn solve(
                 &mut best_eval,
                 stage.vary.len(),
                 &mut ws,
+                &mut |e: &Evaluation| {
+                    records.push(SampleRecord {
+                        stage: k,
+                        iteration,
+                        terms: e.weighted(&stage.weights),
+                        total: e.total,
+                    })
+                },
             );
             samples += moved.samples;
             if moved.accepted > 0 {

@@ -59,9 +59,14 @@ fn solve_and_eval_from_the_command_line() {
         assert!(stdout.contains(f), "solve did not list {f}: {stdout}");
     }
     let csv = std::fs::read_to_string(out.join("convergence.csv")).unwrap();
+    let solution: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("solution.json")).unwrap()).unwrap();
+    let samples = solution["samples"].as_u64().unwrap() as usize;
+    // Two stages of 5 iterations of 12 samples, and the moves tried before each run.
+    assert!(samples >= 2 * 5 * 12, "{samples} samples");
     assert_eq!(
         csv.lines().count(),
-        1 + 2 * 5 * 12,
+        1 + samples,
         "one row per sample plus the header"
     );
     assert!(csv.starts_with(
