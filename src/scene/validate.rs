@@ -786,12 +786,13 @@ struct StageDefaults {
 }
 
 impl StageDefaults {
-    /// The defaults of a stage: the scene's default weights, and restarts for the last
-    /// stage only (the one that varies every body and leaves the result).
+    /// The defaults of a stage: the scene's default weights, and
+    /// [`DEFAULT_RESTARTS`] for the last stage (the one that leaves the result), one
+    /// restart for the others.
     fn of(weights: Weights, last: bool) -> StageDefaults {
         StageDefaults {
             weights,
-            restarts: if last { DEFAULT_RESTARTS } else { 0 },
+            restarts: if last { DEFAULT_RESTARTS } else { 1 },
         }
     }
 }
