@@ -8,7 +8,7 @@
 //! shadow, so nothing draws it out). [`improve`] tries, from the best launch so far:
 //! - **swap** bodies `i` and `j`: each is sent to the other's line of sight from the
 //!   light, at the depth where its own shadow has the other's area, so that the picture
-//!   is unchanged up to the two shapes;
+//!   is unchanged up to the two shapes; or each is sent to the other's place in space;
 //! - **fill** the largest bare part of the target with body `i`: sent to the line of
 //!   sight through the part's centroid, at the depth where its shadow has the part's
 //!   area.
@@ -47,6 +47,8 @@ const TABLE_CLEARANCE: f64 = 0.01;
 /// Where one launched body is at `t`, as the moves see it.
 #[derive(Clone, Copy, Debug)]
 struct Sight {
+    /// The centre of mass.
+    com: DVec3,
     /// The point of the receiver plane on the light's line through the centre of mass.
     on_receiver: DVec3,
     /// The centre's depth along that line: 0 at the light, 1 on the receiver.
@@ -133,9 +135,17 @@ pub fn improve(
                 let (Some(si), Some(sj)) = (sights[i], sights[j]) else {
                     continue;
                 };
+                // Each takes the other's part of the picture at the size that part has
+                // now (the picture changes only by the two shapes) ...
                 candidate.copy_from_slice(params);
                 send(problem, &mut candidate, i, sj.on_receiver, si, sj.area);
                 send(problem, &mut candidate, j, si.on_receiver, sj, si.area);
+                consider(&candidate, &mut report, ws);
+                // ... or the other's place in space (each part's size changes by the
+                // ratio of the two bodies' sizes).
+                candidate.copy_from_slice(params);
+                aim(problem, &mut candidate, i, sj.com);
+                aim(problem, &mut candidate, j, si.com);
                 consider(&candidate, &mut report, ws);
             }
         }
@@ -206,6 +216,7 @@ fn sights(problem: &Problem, movable: &[usize], ws: &mut Workspace) -> Vec<Optio
             continue;
         }
         out[i] = Some(Sight {
+            com,
             on_receiver: light + (com - light) / depth,
             depth,
             area,
@@ -238,11 +249,16 @@ fn send(
         }
     }
     let depth = depth.clamp(MIN_DEPTH, 1.0);
-    let target = light + (on_receiver - light) * depth;
+    aim(problem, params, i, light + (on_receiver - light) * depth);
+}
+
+/// Set body `i`'s launch velocity in `params` so that its centre of mass is at `target`
+/// at `t` (its spin is kept).
+fn aim(problem: &Problem, params: &mut [f64], i: usize, target: DVec3) {
+    let scene = &problem.scene;
     let t = scene.t;
-    let start = o.launch_com();
-    let velocity = (target - start - 0.5 * scene.gravity * t * t) / t;
+    let start = scene.occluders[i].launch_com();
     let mut launch = Launch::get(params, i);
-    launch.velocity = velocity;
+    launch.velocity = (target - start - 0.5 * scene.gravity * t * t) / t;
     launch.set(params, i);
 }

@@ -306,3 +306,124 @@ fn example_scenes_start_without_contact_near_their_targets() {
         assert!(e.iou > 0.5, "{name}: start IoU {}", e.iou);
     }
 }
+
+/// A planted problem of two spheres (`bsa plant`): its problem and the planted launch.
+fn planted_pair(name: &str) -> (Problem, Vec<f64>) {
+    let dir = crate::util::tmpdir(name).join("pair");
+    let (ok, _, err) = crate::util::bsa(&[
+        "plant",
+        dir.to_str().unwrap(),
+        "--objects",
+        "sphere:0.3,sphere:0.18",
+        "--seed",
+        "3",
+        "--width",
+        "4",
+    ]);
+    assert!(ok, "{err}");
+    let p = Problem::new(bsa::scene::load(&dir).unwrap());
+    let planted: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("planted.json")).unwrap()).unwrap();
+    let mut params = vec![0.0; p.scene.variable_count()];
+    for (i, o) in p.scene.occluders.iter().enumerate() {
+        let l = &planted[&o.name];
+        let v = |k: &str, j: usize| l[k][j].as_f64().unwrap();
+        for j in 0..3 {
+            params[6 * i + j] = v("velocity", j);
+            params[6 * i + 3 + j] = v("angular_velocity", j);
+        }
+    }
+    (p, params)
+}
+
+#[test]
+fn moves_send_a_hidden_body_back_to_the_bare_part_of_the_target() {
+    use bsa::optimize::moves;
+    let (p, planted) = planted_pair("moves-hidden");
+    let w = p.scene.stages.last().unwrap().weights;
+    let mut ws = p.workspace();
+    assert!(p.evaluate(&planted, &w, &mut ws).iou > 0.9999);
+    // The small sphere sent just below the large one, on its line of sight from the
+    // light: its shadow hides in the large one's, and half the target is bare.
+    let (light, t, g) = (p.scene.camera.light, p.scene.t, p.scene.gravity);
+    let (origin, q) = ws.poses[0];
+    let large = origin + q * p.scene.occluders[0].mass.local_com;
+    let hidden = light + (large - light) * 1.08;
+    let mut params = planted.clone();
+    let start = p.scene.occluders[1].launch_com();
+    let v = (hidden - start - 0.5 * g * t * t) / t;
+    params[6..9].copy_from_slice(&[v.x, v.y, v.z]);
+    let mut best = p.evaluate(&params, &w, &mut ws);
+    let before = best.iou;
+    assert!(before < 0.9, "IoU {before}");
+    let held = p.hold(&params, &[0, 1]);
+    let rank = |e: &bsa::evaluate::Evaluation| {
+        if e.outcome.own_contact > 0.0 {
+            f64::INFINITY
+        } else {
+            e.total
+        }
+    };
+    let report = moves::improve(
+        &p,
+        &held,
+        &[0, 1],
+        &w,
+        &rank,
+        &mut params,
+        &mut best,
+        2,
+        &mut ws,
+        &mut |_| {},
+    );
+    assert!(report.accepted >= 1, "{report:?}");
+    assert!(
+        best.iou > 0.95 && best.iou > before + 0.05,
+        "IoU {before} -> {}",
+        best.iou
+    );
+    assert_eq!(best.outcome.n_contacts, 0);
+}
+
+#[test]
+fn moves_swap_two_bodies_that_cover_each_others_parts() {
+    use bsa::optimize::moves;
+    let (p, planted) = planted_pair("moves-swap");
+    let w = p.scene.stages.last().unwrap().weights;
+    let mut ws = p.workspace();
+    p.evaluate(&planted, &w, &mut ws);
+    // Each sphere sent where the other was: the large one casts the small part's place
+    // too big, and the small one the large part's too small.
+    let (t, g) = (p.scene.t, p.scene.gravity);
+    let com = |i: usize, ws: &bsa::evaluate::Workspace| {
+        let (origin, q) = ws.poses[i];
+        origin + q * p.scene.occluders[i].mass.local_com
+    };
+    let (c0, c1) = (com(0, &ws), com(1, &ws));
+    let mut params = planted.clone();
+    for (i, to) in [(0, c1), (1, c0)] {
+        let v = (to - p.scene.occluders[i].launch_com() - 0.5 * g * t * t) / t;
+        params[6 * i..6 * i + 3].copy_from_slice(&[v.x, v.y, v.z]);
+    }
+    let mut best = p.evaluate(&params, &w, &mut ws);
+    let before = best.iou;
+    let held = p.hold(&params, &[0, 1]);
+    let rank = |e: &bsa::evaluate::Evaluation| e.total;
+    moves::improve(
+        &p,
+        &held,
+        &[0, 1],
+        &w,
+        &rank,
+        &mut params,
+        &mut best,
+        2,
+        &mut ws,
+        &mut |_| {},
+    );
+    assert!(
+        best.iou > before + 0.05 && best.iou > 0.9,
+        "IoU {before} -> {}",
+        best.iou
+    );
+}
