@@ -143,14 +143,11 @@ def make(name, img_w_m, strokes, launch_y, launch_x_span, stage, final, order, r
     print(f"wrote {path}")
 
 
-WEIGHTS = {"xor": 1.0, "hint": 0.3, "barrier": 1.0, "contact": 100000.0, "reg": 0.01}
-
-
 def main():
-    stage = {"weights": WEIGHTS, "step": 0.05, "population": 24, "max_iterations": 80,
-             "stagnation": 25}
-    final = {"weights": WEIGHTS, "step": 0.02, "population": 32, "max_iterations": 60,
-             "stagnation": 25}
+    # Every scene uses the default weights (no `weights` in its stages) and contacts as
+    # constraints (the scene's default `contacts`).
+    stage = {"step": 0.05, "population": 24, "max_iterations": 80, "stagnation": 25}
+    final = {"step": 0.02, "population": 32, "max_iterations": 60, "stagnation": 25}
     fly = [
         # name, block, stroke start px, stroke end px, stroke width px
         ("bar", "double", (144, 95), (382, 95), 46),
@@ -178,12 +175,11 @@ def main():
     # Thin strokes leave little slack: a second pass lets early bricks use the room
     # that later ones left.
     make("tbc", 1.6, tbc, -1.0, 2.8, stage, final, "auto", rounds=2)
-    # THE THINKER adds the boundary terms (as the paper's Table 4 does) and gives each
-    # stage more room: sixteen pieces leave each other less slack than bricks do.
-    thinker_weights = dict(WEIGHTS, inner=0.5, outer=0.5)
+    # THE THINKER gives each stage more room: sixteen pieces leave each other less slack
+    # than bricks do.
     bsa = str(ROOT / "target" / "release" / "bsa")
-    search_thinker(dict(stage, weights=thinker_weights, max_iterations=200, stagnation=30),
-                   dict(final, weights=thinker_weights, step=0.01, max_iterations=100), bsa)
+    search_thinker(dict(stage, max_iterations=200, stagnation=30),
+                   dict(final, step=0.01, max_iterations=100), bsa)
 
 
 # Chess pieces (scenes/thinker/pieces, examples/chess_pieces.rs): height (m) and
