@@ -126,8 +126,9 @@ struct ExportArgs {
     /// Scene folder or file [default: the one recorded in solution.json, else scenes/<name>].
     #[arg(long)]
     scene: Option<PathBuf>,
-    /// Seconds of rapier continuation after t.
-    #[arg(long, default_value_t = crate::output::trajectory::DEFAULT_AFTER)]
+    /// Longest rapier continuation after t (s): the motion runs until every body is at
+    /// rest (every point slower than 1 cm/s for 0.25 s), or this long.
+    #[arg(long, value_name = "SECONDS", default_value_t = crate::output::trajectory::DEFAULT_MAX_AFTER)]
     after: f64,
 }
 

@@ -41,7 +41,23 @@ fn import_keeps_animation_light_cameras_and_frame_range() {
     assert_eq!(v["fps"].as_f64().unwrap(), 60.0);
     assert_eq!(v["frame_t"].as_f64().unwrap(), 72.0);
     assert_eq!(v["frame_start"], 0);
-    assert_eq!(v["frame_end"], 132, "t + 1 s at 60 fps");
+    // The animation runs until every body is at rest: its last key is the last row of
+    // trajectory.csv.
+    let traj = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
+    let last: f64 = traj
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(
+        v["frame_end"],
+        (last * 60.0).round() as i64,
+        "last key at {last} s"
+    );
     assert_eq!(v["cameras"]["camera_shadow"]["type"], "ORTHO");
     assert!(
         (v["cameras"]["camera_shadow"]["ortho_scale"]
