@@ -1,6 +1,6 @@
 //! The cross-check with Blender (bpy, Cycles): the Cycles shadow at t matches the
 //! rasterizer, Blender imports the glTF with its animation, light, cameras and frame
-//! range, and the video renders. Every test here needs Blender's bpy in `.venv-blender`
+//! range, and the glb renders right as imported (the .blend and the video: `blend`). Every test here needs Blender's bpy in `.venv-blender`
 //! (`bash blender/setup_venv.sh`), so they are ignored by plain `cargo test`;
 //! `scripts/test.sh` installs bpy and runs them (`cargo test -- --include-ignored`).
 
@@ -8,14 +8,14 @@ use std::process::Command;
 
 use bsa::evaluate::Problem;
 
-use crate::util::{bsa, example_scenes, quick_solve, require, root, tmpdir};
+use crate::util::{bsa, example_scenes, quick_solve, require, root, shared_quick_solve, tmpdir};
 
 #[test]
 #[ignore = "needs Blender's bpy in .venv-blender (bash blender/setup_venv.sh); run by scripts/test.sh"]
 fn cycles_mask_matches_the_rasterizer() {
     for scene in example_scenes() {
         let name = scene.file_name().unwrap().to_str().unwrap().to_string();
-        let out = quick_solve(&scene, &format!("cycles-{name}"));
+        let out = shared_quick_solve(&name);
         let (ok, stdout, err) = bsa(&["validate", out.to_str().unwrap()]);
         assert!(ok, "{err}");
         let v: serde_json::Value =
@@ -113,34 +113,6 @@ fn import_keeps_animation_light_cameras_and_frame_range() {
             ws.poses[i].0
         );
     }
-}
-
-#[test]
-#[ignore = "needs Blender's bpy in .venv-blender (bash blender/setup_venv.sh); run by scripts/test.sh"]
-fn video_of_mickey_renders_an_mp4() {
-    let out = quick_solve(&root().join("scenes/mickey"), "video");
-    let mp4 = out.join("short.mp4");
-    let (ok, _, err) = bsa(&[
-        "video",
-        out.to_str().unwrap(),
-        "--out",
-        mp4.to_str().unwrap(),
-        "--samples",
-        "1",
-        "--width",
-        "160",
-        "--height",
-        "120",
-        "--seconds",
-        "0.2",
-    ]);
-    assert!(ok, "{err}");
-    let bytes = std::fs::read(&mp4).unwrap();
-    assert!(
-        bytes.len() > 1000 && &bytes[4..8] == b"ftyp",
-        "not an MP4 ({} bytes)",
-        bytes.len()
-    );
 }
 
 /// Run `blender/<script> -- <args>` with the bpy venv; its `BSA_RESULT` line as JSON.
