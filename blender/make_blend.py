@@ -15,7 +15,7 @@ which only applies it (see docs/blender.md):
     motion to the close shot of the picture at t and back; the scene's camera; the resolution;
   * `camera_shadow` (orthographic, the picture's rectangle) clipped to the 5 cm above the
     receiver, so that it shows the shadow and not the bodies in flight, in a second scene
-    `<name>_shadow` that shares every object, rendered at the target's size;
+    `<name>_shadow` that shares every object but the curves, rendered at the target's size;
   * a hard shadow in both engines: point light radius 0, Cycles (64 samples, denoised) and
     EEVEE (shadows on, no filtering or jitter, fine shadow maps), a dim grey world (strength 0.05);
   * collections `bodies`, `stage` (receiver, table), `lights`, `cameras`, `trajectories`
@@ -245,9 +245,9 @@ def main():
         width = 0.002 * max(1.0, math.dist(c[0], c[1]) + math.dist(c[1], c[2]))
         trajectory_curves(bpy, coll, plan["curves"], width)
 
-    # The shadow scene: the same objects, the shadow camera, the target's size.
+    # The shadow scene: the same objects (not the curves), the shadow camera, the target's size.
     shadow = bpy.data.scenes.new(name + "_shadow")
-    for coll in scene.collection.children:
+    for coll in colls.values():
         shadow.collection.children.link(coll)
     hard_shadow_settings(shadow, world)
     shadow.camera = cam_shadow

@@ -48,14 +48,17 @@ pub(super) fn parse_resolution(text: &str, flag: &str) -> Result<[u32; 2]> {
     }
 }
 
+/// `--fps`: a whole number of frames per second from 1 to 240.
+pub(super) fn check_fps(fps: u32) -> Result<()> {
+    if !(1..=240).contains(&fps) {
+        bail!("--fps must be a whole number of frames per second from 1 to 240, got {fps}");
+    }
+    Ok(())
+}
+
 impl Options {
     pub(super) fn new(args: BlendArgs) -> Result<Options> {
-        if !(1..=240).contains(&args.fps) {
-            bail!(
-                "--fps must be a whole number of frames per second from 1 to 240, got {}",
-                args.fps
-            );
-        }
+        check_fps(args.fps)?;
         let resolution = parse_resolution(&args.resolution, "--resolution")?;
         Ok(Options {
             dir: args.dir,
@@ -134,7 +137,8 @@ pub(super) fn describe(b: &Built) -> String {
     format!(
         "wrote {}: {} fps, frames {} to {} (launch at frame {:.2}, marker `t` on frame {}), {}; \
          the picture (IoU >= 0.9 of its {:.4} at t) stays on screen {:.2} s; camera_view {}x{} \
-         (the picture {:.0} % of the frame's height at t), scene `{}_shadow` with camera_shadow \
+         (the picture {:.0} % of the frame's height at t, seen from {:.0} degrees up), scene \
+         `{}_shadow` with camera_shadow \
          at {}x{}{}\n{}",
         b.blend.display(),
         p.fps,
@@ -148,6 +152,7 @@ pub(super) fn describe(b: &Built) -> String {
         p.resolution[0],
         p.resolution[1],
         100.0 * p.camera.picture_fraction_at_t,
+        p.camera.close_elevation_deg,
         p.scene,
         p.target_size[0],
         p.target_size[1],

@@ -211,7 +211,7 @@ struct VideoArgs {
     #[arg(long)]
     denoise: bool,
     /// Render only the first SECONDS of the film.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     seconds: Option<f64>,
     /// Render only the contact sheet's four stills, no video.
     #[arg(long)]

@@ -41,12 +41,7 @@ impl Options {
         if args.samples == 0 {
             bail!("--samples must be at least 1");
         }
-        if !(1..=240).contains(&args.fps) {
-            bail!(
-                "--fps must be a whole number of frames per second from 1 to 240, got {}",
-                args.fps
-            );
-        }
+        blend::check_fps(args.fps)?;
         let resolution = match &args.resolution {
             Some(r) => {
                 let [w, h] = blend::parse_resolution(r, "--resolution")?;
@@ -188,7 +183,9 @@ fn contact_sheet(result: &serde_json::Value, name: &str) -> Result<image::RgbIma
     }
     let title = format!(
         "{name}: {} fps, t on frame {}, {} samples",
-        result["fps"], result["t_frame"], result["samples"]
+        result["fps"].as_f64().unwrap_or(0.0),
+        result["t_frame"],
+        result["samples"]
     );
     Ok(picture::sheet::contact_sheet(
         &stills,

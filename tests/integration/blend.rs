@@ -8,7 +8,9 @@
 
 use std::path::Path;
 
-use crate::util::{bsa, require, root, shared_full_solve, shared_quick_solve};
+use crate::util::{
+    blender_script, bsa, last_key_time, root, shared_full_solve, shared_quick_solve,
+};
 
 /// `bsa blend <dir> <args>`; the .blend written.
 fn blend(dir: &Path, name: &str, out: &str, args: &[&str]) -> std::path::PathBuf {
@@ -26,25 +28,19 @@ fn blend(dir: &Path, name: &str, out: &str, args: &[&str]) -> std::path::PathBuf
     file
 }
 
-/// `blender/check_blend.py -- <args>`: its report.
-fn check(args: &[&str]) -> serde_json::Value {
-    let python = root().join(".venv-blender/bin/python");
-    require(&python, "bash blender/setup_venv.sh");
-    let o = std::process::Command::new(python)
-        .arg(root().join("blender/check_blend.py"))
-        .arg("--")
-        .args(args)
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&o.stdout);
-    let line = stdout
-        .lines()
-        .rev()
-        .find_map(|l| l.strip_prefix("BSA_RESULT "))
-        .unwrap_or_else(|| panic!("{}", String::from_utf8_lossy(&o.stderr)));
-    let v: serde_json::Value = serde_json::from_str(line).unwrap();
-    assert!(v.get("error").is_none(), "{v}");
-    v
+/// `blender/check_blend.py -- --blend FILE <args>`: its report.
+fn check(file: &Path, args: &[&str]) -> serde_json::Value {
+    let mut a = vec!["--blend", file.to_str().unwrap()];
+    a.extend_from_slice(args);
+    blender_script("check_blend.py", &a)
+}
+
+/// The shadow scene's mask of `file` in `engine` (at the marker `t`, or `--frame`) into
+/// `png`, without the view: the report.
+fn mask(file: &Path, png: &Path, extra: &[&str]) -> serde_json::Value {
+    let mut a = vec!["--no-view", "--mask", png.to_str().unwrap()];
+    a.extend_from_slice(extra);
+    check(file, &a)
 }
 
 /// IoU of the dark pixels (< 128) of two grayscale PNGs of one size.
@@ -71,21 +67,12 @@ fn every_example_blend_shows_the_picture_large_at_t() {
     for name in ["mickey", "fly", "tbc", "thinker"] {
         let dir = shared_full_solve(name);
         let file = blend(&dir, name, &format!("{name}.blend"), &[]);
-        let v = check(&["--blend", file.to_str().unwrap()]);
+        let v = check(&file, &[]);
         eprintln!("{name}: view {}", v["view"]);
         assert_eq!(v["fps"], 24.0, "{v}");
         assert_eq!(v["t_frame_whole"], true, "{v}");
         assert_eq!(v["frame_start"], 0, "{v}");
-        let traj = std::fs::read_to_string(dir.join("trajectory.csv")).unwrap();
-        let last: f64 = traj
-            .lines()
-            .last()
-            .unwrap()
-            .split(',')
-            .next()
-            .unwrap()
-            .parse()
-            .unwrap();
+        let last = last_key_time(&dir);
         let end = v["frame_end"].as_f64().unwrap();
         // The last key (every body at rest), moved by less than a frame.
         assert!(
@@ -122,14 +109,8 @@ fn t_is_a_whole_frame_where_cycles_draws_the_rasterizers_shadow_at_any_fps() {
                 &format!("{name}_{fps}.blend"),
                 &["--fps", &fps.to_string()],
             );
-            let mask = dir.join(format!("mask_{fps}.png"));
-            let v = check(&[
-                "--blend",
-                file.to_str().unwrap(),
-                "--no-view",
-                "--mask",
-                mask.to_str().unwrap(),
-            ]);
+            let png = dir.join(format!("mask_{fps}.png"));
+            let v = mask(&file, &png, &[]);
             assert_eq!(v["fps"], fps as f64);
             assert_eq!(v["t_frame_whole"], true, "{v}");
             let t_frame = v["t_frame"].as_f64().unwrap();
@@ -137,7 +118,7 @@ fn t_is_a_whole_frame_where_cycles_draws_the_rasterizers_shadow_at_any_fps() {
             // Two channels (location, rotation) of three or four components per body.
             assert!(v["channels_keyed_at_t"].as_u64().unwrap() >= 6, "{v}");
             assert_eq!(v["mask"]["covered_pixels"], 640 * 480);
-            let i = iou(&mask, &dir.join("shadow.png"));
+            let i = iou(&png, &dir.join("shadow.png"));
             eprintln!("{name} at {fps} fps: t on frame {t_frame}, Cycles vs rasterizer IoU {i:.5}");
             assert!(i >= 0.995, "{name} at {fps} fps: IoU {i}");
         }
@@ -152,18 +133,10 @@ fn t_is_a_whole_frame_where_cycles_draws_the_rasterizers_shadow_at_any_fps() {
 fn eevee_draws_the_hard_shadow_at_t() {
     let dir = shared_full_solve("mickey");
     let file = blend(&dir, "mickey", "mickey_eevee.blend", &[]);
-    let mask = dir.join("eevee_mask.png");
-    let v = check(&[
-        "--blend",
-        file.to_str().unwrap(),
-        "--no-view",
-        "--mask",
-        mask.to_str().unwrap(),
-        "--engine",
-        "EEVEE",
-    ]);
-    let target = iou(&mask, &root().join("scenes/mickey/target.png"));
-    let raster = iou(&mask, &dir.join("shadow.png"));
+    let png = dir.join("eevee_mask.png");
+    let v = mask(&file, &png, &["--engine", "EEVEE"]);
+    let target = iou(&png, &root().join("scenes/mickey/target.png"));
+    let raster = iou(&png, &dir.join("shadow.png"));
     let m = &v["mask"];
     eprintln!(
         "EEVEE at t: IoU {target:.4} vs target, {raster:.4} vs rasterizer; lit {} shadow {}; {} s",
@@ -189,13 +162,7 @@ fn slow_motion_keeps_the_picture_on_screen_and_curves_cast_no_shadow() {
         &["--fps", "25", "--slowmo", "--curves"],
     );
     let at_t = dir.join("slowmo_t.png");
-    let v = check(&[
-        "--blend",
-        file.to_str().unwrap(),
-        "--no-view",
-        "--mask",
-        at_t.to_str().unwrap(),
-    ]);
+    let v = mask(&file, &at_t, &[]);
     assert_eq!(v["t_frame_whole"], true, "{v}");
     assert_eq!(v["curves"].as_array().unwrap().len(), 6, "{v}");
     assert_eq!(v["curves_cast_shadows"], false);
@@ -214,17 +181,9 @@ fn slow_motion_keeps_the_picture_on_screen_and_curves_cast_no_shadow() {
     let target = root().join("scenes/fly/target.png");
     let at_t_iou = iou(&at_t, &target);
     for (k, f) in [frames[0].ceil(), frames[1].floor()].iter().enumerate() {
-        let mask = dir.join(format!("slowmo_{k}.png"));
-        check(&[
-            "--blend",
-            file.to_str().unwrap(),
-            "--no-view",
-            "--mask",
-            mask.to_str().unwrap(),
-            "--frame",
-            &f.to_string(),
-        ]);
-        let i = iou(&mask, &target);
+        let png = dir.join(format!("slowmo_{k}.png"));
+        mask(&file, &png, &["--frame", &f.to_string()]);
+        let i = iou(&png, &target);
         eprintln!("fly slow motion: frame {f}: IoU {i:.4} vs {at_t_iou:.4} at t, {on_screen:.2} s on screen");
         assert!(i >= 0.9 * at_t_iou - 0.01, "frame {f}: IoU {i}");
     }

@@ -4,11 +4,12 @@
 //! (`bash blender/setup_venv.sh`), so they are ignored by plain `cargo test`;
 //! `scripts/test.sh` installs bpy and runs them (`cargo test -- --include-ignored`).
 
-use std::process::Command;
-
 use bsa::evaluate::Problem;
 
-use crate::util::{bsa, example_scenes, quick_solve, require, root, shared_quick_solve, tmpdir};
+use crate::util::{
+    blender_script, bsa, example_scenes, last_key_time, quick_solve, require, root,
+    shared_quick_solve, tmpdir,
+};
 
 #[test]
 #[ignore = "needs Blender's bpy in .venv-blender (bash blender/setup_venv.sh); run by scripts/test.sh"]
@@ -37,22 +38,13 @@ fn import_keeps_animation_light_cameras_and_frame_range() {
     );
     let out = quick_solve(&root().join("scenes/mickey"), "blender-import");
     let glb = out.join("mickey.glb");
-    let v = run_script("check_import.py", &["--glb", glb.to_str().unwrap()]);
+    let v = blender_script("check_import.py", &["--glb", glb.to_str().unwrap()]);
     assert_eq!(v["fps"].as_f64().unwrap(), 60.0);
     assert_eq!(v["frame_t"].as_f64().unwrap(), 72.0);
     assert_eq!(v["frame_start"], 0);
     // The animation runs until every body is at rest: its last key is the last row of
     // trajectory.csv.
-    let traj = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
-    let last: f64 = traj
-        .lines()
-        .last()
-        .unwrap()
-        .split(',')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let last = last_key_time(&out);
     assert_eq!(
         v["frame_end"],
         (last * 60.0).round() as i64,
@@ -115,27 +107,6 @@ fn import_keeps_animation_light_cameras_and_frame_range() {
     }
 }
 
-/// Run `blender/<script> -- <args>` with the bpy venv; its `BSA_RESULT` line as JSON.
-fn run_script(script: &str, args: &[&str]) -> serde_json::Value {
-    require(
-        &root().join(".venv-blender/bin/python"),
-        "bash blender/setup_venv.sh",
-    );
-    let o = Command::new(root().join(".venv-blender/bin/python"))
-        .arg(root().join("blender").join(script))
-        .arg("--")
-        .args(args)
-        .output()
-        .expect("the bpy virtualenv (bash blender/setup_venv.sh)");
-    let stdout = String::from_utf8_lossy(&o.stdout);
-    let line = stdout
-        .lines()
-        .rev()
-        .find_map(|l| l.strip_prefix("BSA_RESULT "))
-        .unwrap_or_else(|| panic!("{}", String::from_utf8_lossy(&o.stderr)));
-    serde_json::from_str(line).unwrap()
-}
-
 #[test]
 #[ignore = "needs Blender's bpy in .venv-blender (bash blender/setup_venv.sh); run by scripts/test.sh"]
 fn glb_renders_the_picture_as_imported() {
@@ -148,7 +119,7 @@ fn glb_renders_the_picture_as_imported() {
     assert!(ok, "{err}");
     let glb = out.join("mickey.glb");
     let target = root().join("scenes/mickey/target.png");
-    let v = run_script(
+    let v = blender_script(
         "check_render.py",
         &[
             "--glb",

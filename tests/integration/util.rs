@@ -146,3 +146,33 @@ pub fn shared_full_solve(name: &str) -> PathBuf {
         out
     })
 }
+
+/// Runs `blender/<script> -- <args>` with the bpy venv (which it requires) and returns
+/// the JSON of its `BSA_RESULT` line, refusing a reported error.
+pub fn blender_script(script: &str, args: &[&str]) -> serde_json::Value {
+    let python = root().join(".venv-blender/bin/python");
+    require(&python, "bash blender/setup_venv.sh");
+    let o = Command::new(python)
+        .arg(root().join("blender").join(script))
+        .arg("--")
+        .args(args)
+        .output()
+        .expect("the bpy virtualenv (bash blender/setup_venv.sh)");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let line = stdout
+        .lines()
+        .rev()
+        .find_map(|l| l.strip_prefix("BSA_RESULT "))
+        .unwrap_or_else(|| panic!("{script}: {}", String::from_utf8_lossy(&o.stderr)));
+    let v: serde_json::Value = serde_json::from_str(line).unwrap();
+    assert!(v.get("error").is_none(), "{script}: {v}");
+    v
+}
+
+/// The time of the last key of an output folder's trajectory.csv (s): the end of the
+/// animation, every body at rest.
+pub fn last_key_time(dir: &Path) -> f64 {
+    let traj = std::fs::read_to_string(dir.join("trajectory.csv")).unwrap();
+    let last = traj.lines().last().unwrap();
+    last.split(',').next().unwrap().parse().unwrap()
+}

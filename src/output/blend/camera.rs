@@ -6,8 +6,8 @@
 //! the picture stays large) shows the picture largest among those from which the bodies
 //! at `t` hide little of it (each dark target pixel's line of sight tested against every
 //! body's bounding sphere, [`hidden_share`]). [`follow_shot`] frames the bodies of one
-//! instant from the same side, lower: the camera follows the flight. [`picture_fraction`] measures the share of the frame's
-//! height the picture's bounding box takes.
+//! instant from the same side, lower: the camera follows the flight. [`picture_fraction`]
+//! measures the share of the frame's height the picture's bounding box takes.
 
 use glam::{DMat3, DQuat, DVec3};
 
@@ -19,13 +19,14 @@ pub const ASPECT: f64 = 16.0 / 9.0;
 /// The close shot's picture fills at least this share of the frame's height when the
 /// bodies at `t` are framed with it; otherwise the close shot frames the picture alone.
 const CLOSE_WITH_BODIES_MIN: f64 = 0.5;
-/// Share of the frame (half-extent from the centre) the framed points may fill.
-const WIDE_FILL: f64 = 0.92;
+/// Share of the frame (half-extent from the centre) the framed points may fill: in the
+/// following shot, the close shot with the bodies, the close shot of the picture alone.
+const FOLLOW_FILL: f64 = 0.92;
 const CLOSE_FILL: f64 = 0.9;
 const PICTURE_FILL: f64 = 0.9;
-/// The wide shot's elevation above the horizontal (rad): 35 degrees, as the glb's
+/// The following shot's elevation above the horizontal (rad): 35 degrees, as the glb's
 /// `camera_view`.
-const WIDE_ELEVATION: f64 = 35.0 * std::f64::consts::PI / 180.0;
+const FOLLOW_ELEVATION: f64 = 35.0 * std::f64::consts::PI / 180.0;
 /// The bodies at `t` may hide at most this share of the picture from the close shot.
 const MAX_HIDDEN: f64 = 0.05;
 
@@ -237,7 +238,7 @@ pub fn follow_direction(close_dir: DVec3) -> DVec3 {
     let flat = (close_dir - DVec3::Z * close_dir.z)
         .try_normalize()
         .unwrap_or(-DVec3::Y);
-    flat * WIDE_ELEVATION.cos() + DVec3::Z * WIDE_ELEVATION.sin()
+    flat * FOLLOW_ELEVATION.cos() + DVec3::Z * FOLLOW_ELEVATION.sin()
 }
 
 /// The following shot of one instant: the bodies then (centres and bounding radii) in
@@ -247,7 +248,7 @@ pub fn follow_shot(dir: DVec3, bodies: &[(DVec3, f64)], min_radius: f64) -> Pose
     let centre = bodies.iter().map(|(p, _)| *p).sum::<DVec3>() / bodies.len().max(1) as f64;
     let mut pts: Vec<(DVec3, f64)> = bodies.to_vec();
     pts.push((centre, min_radius));
-    fit(&pts, dir, WIDE_FILL)
+    fit(&pts, dir, FOLLOW_FILL)
 }
 
 /// The close shot along `dir`: the picture's bounding box and the bodies at `t` when the

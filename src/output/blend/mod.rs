@@ -69,6 +69,8 @@ pub struct CameraPlan {
     pub picture_fraction_at_t: f64,
     /// Share of the picture the bodies at `t` hide from the close shot (bounding spheres).
     pub picture_hidden_at_t: f64,
+    /// The close shot's elevation above the horizontal (degrees).
+    pub close_elevation_deg: f64,
 }
 
 /// The picture's readable window and how long it stays on screen.
@@ -199,27 +201,16 @@ pub fn plan(problem: &Problem, track: &Track, opts: &BlendOptions) -> Result<Pla
     let frame_start = map.frame_of(0.0).floor() as i64;
 
     // The camera.
-    let bodies_at = |k: usize| -> Vec<(DVec3, f64)> {
-        scene
-            .occluders
-            .iter()
-            .zip(&track.poses[k])
-            .map(|(o, (p, q))| (*p + *q * o.mass.local_com, o.bounding_radius))
-            .collect()
-    };
-    let at_t = bodies_at(track.t_index);
+    let at_t = bodies(problem, &track.poses[track.t_index]);
     let (dir, close, hidden) = camera::choose_close_shot(scene, &corners, &dark, &at_t);
     let follow_dir = camera::follow_direction(dir);
-    // The following shot is at least a third of the picture's size across.
     let min_radius = FOLLOW_MIN_SHARE * corners[0].distance(corners[2]);
     let follow = |time: f64| {
-        let bodies: Vec<(DVec3, f64)> = scene
-            .occluders
-            .iter()
-            .zip(track.poses_at(time))
-            .map(|(o, (p, q))| (p + q * o.mass.local_com, o.bounding_radius))
-            .collect();
-        camera::follow_shot(follow_dir, &bodies, min_radius)
+        camera::follow_shot(
+            follow_dir,
+            &bodies(problem, &track.poses_at(time)),
+            min_radius,
+        )
     };
     let keys = camera_keys(&map, t, &readable, frame_start, frame_end, close, follow);
 
@@ -234,49 +225,11 @@ pub fn plan(problem: &Problem, track: &Track, opts: &BlendOptions) -> Result<Pla
         }
     };
     let curves = if opts.curves {
-        scene
-            .occluders
-            .iter()
-            .enumerate()
-            .map(|(i, o)| Curve {
-                name: o.name.clone(),
-                points: (0..=track.t_index)
-                    .map(|k| {
-                        let (p, q) = track.poses[k][i];
-                        (p + q * o.mass.local_com).to_array()
-                    })
-                    .collect(),
-            })
-            .collect()
+        curves(problem, track)
     } else {
         Vec::new()
     };
-    let end_time = *track.times.last().unwrap_or(&t);
-    let contact_sheet = vec![
-        SheetFrame {
-            label: "launch (0 s)".into(),
-            frame: frame_start,
-        },
-        SheetFrame {
-            label: format!("mid-flight ({:.2} s)", t / 2.0),
-            frame: map.frame_of(t / 2.0).round() as i64,
-        },
-        SheetFrame {
-            label: format!("t = {t} s: the picture"),
-            frame: t_frame,
-        },
-        SheetFrame {
-            label: format!(
-                "after: {} ({end_time:.2} s)",
-                if track.rest.at_rest {
-                    "at rest"
-                } else {
-                    "the end"
-                }
-            ),
-            frame: frame_end,
-        },
-    ];
+    let contact_sheet = contact_sheet(&map, track, t, frame_start, frame_end);
     Ok(Plan {
         scene: scene.name.clone(),
         fps: opts.fps,
@@ -305,10 +258,72 @@ pub fn plan(problem: &Problem, track: &Track, opts: &BlendOptions) -> Result<Pla
             keys,
             picture_fraction_at_t: camera::picture_fraction(&close, &corners),
             picture_hidden_at_t: hidden,
+            close_elevation_deg: dir.z.clamp(-1.0, 1.0).asin().to_degrees(),
         },
         curves,
         contact_sheet,
     })
+}
+
+/// The bodies' centres of mass at `poses` and their bounding radii.
+fn bodies(problem: &Problem, poses: &[(DVec3, glam::DQuat)]) -> Vec<(DVec3, f64)> {
+    problem
+        .scene
+        .occluders
+        .iter()
+        .zip(poses)
+        .map(|(o, (p, q))| (*p + *q * o.mass.local_com, o.bounding_radius))
+        .collect()
+}
+
+/// Each body's flight to `t`: its centre of mass at every key.
+fn curves(problem: &Problem, track: &Track) -> Vec<Curve> {
+    let mut out: Vec<Curve> = problem
+        .scene
+        .occluders
+        .iter()
+        .map(|o| Curve {
+            name: o.name.clone(),
+            points: Vec::with_capacity(track.t_index + 1),
+        })
+        .collect();
+    for poses in &track.poses[..=track.t_index] {
+        for (c, (p, _)) in out.iter_mut().zip(bodies(problem, poses)) {
+            c.points.push(p.to_array());
+        }
+    }
+    out
+}
+
+/// The contact sheet's frames: the launch, mid-flight (`t / 2`), `t`, and the last frame.
+fn contact_sheet(
+    map: &TimeMap,
+    track: &Track,
+    t: f64,
+    frame_start: i64,
+    frame_end: i64,
+) -> Vec<SheetFrame> {
+    let end_time = *track.times.last().unwrap_or(&t);
+    let after = if track.rest.at_rest {
+        "at rest"
+    } else {
+        "the end"
+    };
+    [
+        ("launch (0 s)".to_string(), frame_start),
+        (
+            format!("mid-flight ({:.2} s)", t / 2.0),
+            map.frame_of(t / 2.0).round() as i64,
+        ),
+        (
+            format!("t = {t} s: the picture"),
+            map.frame_of(t).round() as i64,
+        ),
+        (format!("after: {after} ({end_time:.2} s)"), frame_end),
+    ]
+    .into_iter()
+    .map(|(label, frame)| SheetFrame { label, frame })
+    .collect()
 }
 
 /// The receiver point at the centre of pixel-space point `(x, y)` of the target (pixels
