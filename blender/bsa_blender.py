@@ -242,6 +242,18 @@ def classify(receiver_name="receiver", table_name="table"):
     return roles
 
 
+def action_fcurves(action):
+    """Every F-curve of an action: Blender 5.0 keeps them in layers, strips and channel bags (one
+    bag per slot, i.e. per animated object); older versions in `action.fcurves`."""
+    if hasattr(action, "layers") and len(action.layers):
+        for layer in action.layers:
+            for strip in layer.strips:
+                for bag in getattr(strip, "channelbags", []):
+                    yield from bag.fcurves
+    elif hasattr(action, "fcurves"):
+        yield from action.fcurves
+
+
 def set_frame(scene, frame):
     """Go to a (possibly fractional) frame."""
     fi = math.floor(frame)
@@ -288,6 +300,31 @@ def cycles_common(scene, samples, max_bounces):
     scene.render.resolution_percentage = 100
     scene.render.use_border = False
     scene.render.use_persistent_data = False
+
+
+def image_output(scene, path):
+    """Render stills to `path` as an 8-bit RGB PNG."""
+    r = scene.render
+    im = r.image_settings
+    if hasattr(im, "media_type"):  # bpy 5.0: media_type before file_format
+        im.media_type = "IMAGE"
+    im.file_format = "PNG"
+    im.color_mode = "RGB"
+    im.color_depth = "8"
+    r.filepath = os.path.abspath(path)
+    r.use_file_extension = False
+
+
+def load_pixels(path):
+    """A PNG as a (height, width, 4) float array, top row first (Blender's rows run bottom-up)."""
+    import bpy
+    import numpy as np
+    img = bpy.data.images.load(os.path.abspath(path))
+    w, h = img.size
+    px = np.empty(w * h * 4, dtype=np.float32)
+    img.pixels.foreach_get(px)
+    bpy.data.images.remove(img)
+    return px.reshape(h, w, 4)[::-1]
 
 
 # ---------------------------------------------------------------------------------------------

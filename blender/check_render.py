@@ -28,16 +28,6 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bsa_blender as B  # noqa: E402
 
 
-def load_pixels(bpy, np, path):
-    """(height, width, 4) float array, top row first."""
-    img = bpy.data.images.load(os.path.abspath(path))
-    w, h = img.size
-    px = np.empty(w * h * 4, dtype=np.float32)
-    img.pixels.foreach_get(px)
-    bpy.data.images.remove(img)
-    return px.reshape(h, w, 4)[::-1]
-
-
 def main():
     p = argparse.ArgumentParser(prog="check_render.py")
     p.add_argument("--glb", required=True)
@@ -71,7 +61,7 @@ def main():
     roles = B.classify()
     for o in roles["occluder"]:
         o.visible_camera = False
-    target = load_pixels(bpy, np, args.target)
+    target = B.load_pixels(args.target)
     th, tw = target.shape[:2]
     w, h = max(1, int(round(tw * args.scale))), max(1, int(round(th * args.scale)))
     r = scene.render
@@ -81,18 +71,11 @@ def main():
 
     tmpdir = tempfile.mkdtemp(prefix="bsa_check_render_")
     raw = args.keep_render or os.path.join(tmpdir, "render.png")
-    im = r.image_settings
-    if hasattr(im, "media_type"):  # bpy 5.0
-        im.media_type = "IMAGE"
-    im.file_format = "PNG"
-    im.color_mode = "RGB"
-    im.color_depth = "8"
-    r.filepath = os.path.abspath(raw)
-    r.use_file_extension = False
+    B.image_output(scene, raw)
     t0 = timer()
     bpy.ops.render.render(write_still=True)
     t_render = timer() - t0
-    px = load_pixels(bpy, np, raw)
+    px = B.load_pixels(raw)
     if px.shape[:2] != (h, w):
         B.fail("render size %r != %dx%d" % (px.shape[:2], w, h))
     luma = 0.2126 * px[..., 0] + 0.7152 * px[..., 1] + 0.0722 * px[..., 2]

@@ -8,7 +8,9 @@ use anyhow::{bail, Context, Result};
 use crate::evaluate::Problem;
 use crate::output::files;
 use crate::output::solution::Solution;
+use crate::output::trajectory::Track;
 use crate::scene::{MAX_KEYS, MAX_T};
+use crate::sim::continuation::{REST_HOLD_S, REST_SPEED_M_S};
 
 use super::{load, ExportArgs};
 
@@ -16,7 +18,7 @@ use super::{load, ExportArgs};
 pub(super) struct Options {
     dir: PathBuf,
     scene: Option<PathBuf>,
-    /// Seconds of rapier continuation after `t`: finite and not negative.
+    /// Longest rapier continuation after `t` (s): finite and not negative.
     after: f64,
 }
 
@@ -37,18 +39,21 @@ impl Options {
 /// Load the solution folder and write its exports next to the solution.
 pub(super) fn run(opts: &Options) -> Result<()> {
     let (problem, solution) = load::solution_dir(&opts.dir, opts.scene.as_deref())?;
-    let msg = write_exports(&opts.dir, &problem, &solution, opts.after)?;
+    let (msg, _) = write_exports(&opts.dir, &problem, &solution, opts.after)?;
     println!("{msg}");
     Ok(())
 }
 
-/// `<scene>.glb`, `launch.csv` and `trajectory.csv`; returns a one-line summary.
+/// `<scene>.glb`, `launch.csv` and `trajectory.csv`, the continuation running until every
+/// body is at rest or `after` seconds after `t`; returns a summary (a line, and a second
+/// one when the cap stopped the motion) and the track. A file whose bytes would not
+/// change is left alone (its modification time too).
 pub(super) fn write_exports(
     dir: &Path,
     problem: &Problem,
     solution: &Solution,
     after: f64,
-) -> Result<String> {
+) -> Result<(String, Track)> {
     // The continuation stores a pose per key and body, so its key count is bounded as
     // the scene's is.
     let keys = after / problem.scene.dt;
@@ -64,17 +69,47 @@ pub(super) fn write_exports(
     let launches = crate::output::trajectory::launch_rows(problem, &params);
     let glb = crate::output::gltf::write_glb_with_launches(&problem.scene, &track, Some(&launches))
         .context("cannot build the glTF file")?;
-    files::write_atomic(&dir.join(format!("{name}.glb")), &glb)?;
-    files::write_csv(&dir.join("launch.csv"), &launches)?;
-    files::write_csv(
-        &dir.join("trajectory.csv"),
-        &crate::output::trajectory::trajectory_rows(problem, &track),
-    )?;
-    Ok(format!(
-        "wrote {}/{{{name}.glb, launch.csv, trajectory.csv}}: {} keys, t = {} s at key {}",
+    files::write_if_changed(&dir.join(format!("{name}.glb")), &glb)?;
+    let path = dir.join("launch.csv");
+    files::write_if_changed(&path, &files::csv_bytes(&path, &launches)?)?;
+    let path = dir.join("trajectory.csv");
+    let rows = crate::output::trajectory::trajectory_rows(problem, &track);
+    files::write_if_changed(&path, &files::csv_bytes(&path, &rows)?)?;
+    let msg = format!(
+        "wrote {}/{{{name}.glb, launch.csv, trajectory.csv}}: {} keys, t = {} s at key {}; {}",
         dir.display(),
         track.times.len(),
         problem.scene.t,
-        track.t_index
-    ))
+        track.t_index,
+        rest_summary(problem, &track, after)
+    );
+    Ok((msg, track))
+}
+
+/// How the motion after `t` ended, in words: at rest (when), or stopped at the cap with
+/// the bodies still moving and what to do.
+pub(super) fn rest_summary(problem: &Problem, track: &Track, after: f64) -> String {
+    let t = problem.scene.t;
+    let end = track.times.last().copied().unwrap_or(t);
+    match track.rest.since {
+        Some(since) if track.rest.at_rest => format!(
+            "every body at rest {:.2} s after t (no point faster than {REST_SPEED_M_S} m/s for {REST_HOLD_S} s); the animation ends at {end:.2} s",
+            since - t
+        ),
+        _ => {
+            let moving: Vec<String> = problem
+                .scene
+                .occluders
+                .iter()
+                .zip(&track.rest.last_speeds)
+                .filter(|(_, &s)| s >= REST_SPEED_M_S)
+                .map(|(o, s)| format!("{} {s:.3} m/s", o.name))
+                .collect();
+            format!(
+                "the motion after t stopped at the cap of --after {after} s with {} still moving ({}): the animation ends with them in motion; give a longer --after",
+                moving.len(),
+                moving.join(", ")
+            )
+        }
+    }
 }

@@ -16,6 +16,7 @@
 //! This is the only module that uses `anyhow`, prints, draws progress bars or installs
 //! the Ctrl-C handler; library modules return typed errors.
 
+mod blend;
 mod blender;
 mod budget;
 mod check;
@@ -62,7 +63,12 @@ enum Command {
     Export(ExportArgs),
     /// Render the shadow at t with Blender Cycles and compare it with the rasterizer (IoU, XOR).
     Validate(ValidateArgs),
-    /// Render an MP4 of the flight with Blender from the perspective camera.
+    /// Write <scene>.blend, ready to render: fps, t on a whole frame (marker `t`), frames
+    /// from the launch until every body is at rest, a view camera (16:9) and a shadow
+    /// scene, hard shadows in Cycles and EEVEE; optional slow motion and trajectory curves.
+    Blend(BlendArgs),
+    /// Render the film of <scene>.blend (written first, as `bsa blend`): an MP4 from the
+    /// view camera (1920x1080 by default) and a contact sheet of four stills beside it.
     Video(VideoArgs),
     /// Error budget of a saved solution: re-simulation with air drag, drag-compensated
     /// launch table (launch_drag.csv), Monte Carlo of launch errors, sensitivities and
@@ -126,8 +132,9 @@ struct ExportArgs {
     /// Scene folder or file [default: the one recorded in solution.json, else scenes/<name>].
     #[arg(long)]
     scene: Option<PathBuf>,
-    /// Seconds of rapier continuation after t.
-    #[arg(long, default_value_t = crate::output::trajectory::DEFAULT_AFTER)]
+    /// Longest rapier continuation after t (s): the motion runs until every body is at
+    /// rest (every point slower than 1 cm/s for 0.25 s), or this long.
+    #[arg(long, value_name = "SECONDS", default_value_t = crate::output::trajectory::DEFAULT_MAX_AFTER)]
     after: f64,
 }
 
@@ -144,26 +151,71 @@ struct ValidateArgs {
     python: Option<PathBuf>,
 }
 
+// Raw arguments of `bsa blend`.
+#[derive(Args)]
+struct BlendArgs {
+    /// Output folder of a solve (holding solution.json).
+    dir: PathBuf,
+    /// Scene folder or file [default: as for `export`].
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// Output file [default: DIR/<scene>.blend].
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Frames per second of the film (t is put on a whole frame).
+    #[arg(long, default_value_t = 24)]
+    fps: u32,
+    /// Render size of the view camera, WIDTHxHEIGHT in pixels.
+    #[arg(long, value_name = "WxH", default_value = "1920x1080")]
+    resolution: String,
+    /// Slow the motion down around t so that the picture stays on screen at least 0.5 s.
+    #[arg(long)]
+    slowmo: bool,
+    /// Draw each body's flight to t as a curve (collection `trajectories`).
+    #[arg(long)]
+    curves: bool,
+    /// Python with the `bpy` module [default: $BSA_PYTHON, else .venv-blender/bin/python].
+    #[arg(long)]
+    python: Option<PathBuf>,
+}
+
 // Raw arguments of `bsa video`.
 #[derive(Args)]
 struct VideoArgs {
-    /// Output folder of a solve or export (holding solution.json and <scene>.glb).
+    /// Output folder of a solve (holding solution.json).
     dir: PathBuf,
-    /// Output file [default: DIR/<scene>.mp4].
+    /// Output file [default: <the .blend's folder and name>.mp4]; the contact sheet goes
+    /// beside it as <name>_contact_sheet.png.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Cycles samples per pixel.
-    #[arg(long, default_value_t = 4)]
-    samples: u32,
-    /// Frame width in pixels.
-    #[arg(long, default_value_t = 640)]
-    width: u32,
-    /// Frame height in pixels.
-    #[arg(long, default_value_t = 480)]
-    height: u32,
-    /// Render only the first SECONDS of the animation.
+    /// Render this .blend as it is [default: write DIR/<scene>.blend first, as `bsa blend`
+    /// with the options below].
+    #[arg(long, value_name = "FILE")]
+    blend: Option<PathBuf>,
+    /// Frames per second of the film (t is put on a whole frame).
+    #[arg(long, default_value_t = 24)]
+    fps: u32,
+    /// Frame size, WIDTHxHEIGHT in pixels, even [default: 1920x1080, or the --blend file's].
+    #[arg(long, value_name = "WxH")]
+    resolution: Option<String>,
+    /// Slow the motion down around t so that the picture stays on screen at least 0.5 s.
     #[arg(long)]
+    slowmo: bool,
+    /// Draw each body's flight to t as a curve.
+    #[arg(long)]
+    curves: bool,
+    /// Cycles samples per pixel.
+    #[arg(long, default_value_t = 16)]
+    samples: u32,
+    /// Denoise every frame (OpenImageDenoise; slow on a CPU).
+    #[arg(long)]
+    denoise: bool,
+    /// Render only the first SECONDS of the film.
+    #[arg(long, allow_negative_numbers = true)]
     seconds: Option<f64>,
+    /// Render only the contact sheet's four stills, no video.
+    #[arg(long)]
+    sheet_only: bool,
     /// Python with the `bpy` module [default: $BSA_PYTHON, else .venv-blender/bin/python].
     #[arg(long)]
     python: Option<PathBuf>,
@@ -325,6 +377,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Eval(args) => eval::run(&eval::Options::new(args)),
         Command::Export(args) => export::run(&export::Options::new(args)?),
         Command::Validate(args) => validate::run(&validate::Options::new(args)),
+        Command::Blend(args) => blend::run(&blend::Options::new(args)?),
         Command::Video(args) => video::run(&video::Options::new(args)?),
         Command::Budget(args) => budget::run(&budget::Options::new(args)),
         Command::Render(args) => render::run(&render::Options::new(args)?),

@@ -81,7 +81,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     clock.lap("scene loading and set-up");
     let scene = &problem.scene;
     let needed = guard::estimated_bytes(
-        (scene.t + crate::output::trajectory::DEFAULT_AFTER) / scene.dt,
+        (scene.t + crate::output::trajectory::DEFAULT_MAX_AFTER) / scene.dt,
         scene.occluders.len(),
         scene.target.width() * scene.target.height(),
     );
@@ -204,11 +204,11 @@ fn solve_into(
     files::write_pictures(&out, &scene.target, &ws.mask, &title)?;
     files::write_preview(&out, &scene.target, &ws.mask)?;
     clock.lap("shadow, overlay and preview");
-    let exported = export::write_exports(
+    let (exported, _) = export::write_exports(
         &out,
         problem,
         &solution,
-        crate::output::trajectory::DEFAULT_AFTER,
+        crate::output::trajectory::DEFAULT_MAX_AFTER,
     )?;
     clock.lap("exports (motion after t, glb, CSV)");
     let report = crate::output::report::write_report(&out, &solution)?;

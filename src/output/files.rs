@@ -335,6 +335,12 @@ pub fn write_convergence_plot(
 
 /// Write rows as a CSV file (header from the field names), atomically.
 pub fn write_csv<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<()> {
+    write_atomic(path, &csv_bytes(path, rows)?)
+}
+
+/// The bytes of a CSV file of `rows` (header from the field names); `path` names the
+/// file in an error.
+pub fn csv_bytes<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<Vec<u8>> {
     let enc = |message: String| ExportError::Encode {
         path: path.to_path_buf(),
         message,
@@ -343,8 +349,17 @@ pub fn write_csv<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<()> {
     for r in rows {
         w.serialize(r).map_err(|e| enc(e.to_string()))?;
     }
-    let bytes = w.into_inner().map_err(|e| enc(e.to_string()))?;
-    write_atomic(path, &bytes)
+    w.into_inner().map_err(|e| enc(e.to_string()))
+}
+
+/// [`write_atomic`] unless the file already holds exactly `bytes`, so that rewriting an
+/// unchanged export keeps its modification time; true if it wrote.
+pub fn write_if_changed(path: &Path, bytes: &[u8]) -> Result<bool> {
+    if std::fs::read(path).is_ok_and(|old| old == bytes) {
+        return Ok(false);
+    }
+    write_atomic(path, bytes)?;
+    Ok(true)
 }
 
 /// Read `convergence.csv` back (for `--resume`), keeping the rows of stages below `stages`.

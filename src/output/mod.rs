@@ -2,8 +2,10 @@
 //! `convergence.csv`, and the check that a solution belongs to a scene), [`files`]
 //! (atomic writes and reads of the output folder), [`trajectory`] (the whole motion and
 //! the launch and trajectory tables), [`gltf`] (the animated glTF 2.0 file) and
-//! [`picture`] (overlays and plots for people) and [`report`] (`report.html`).
+//! [`picture`] (overlays and plots for people), [`report`] (`report.html`) and [`blend`]
+//! (the plan of the .blend ready to render: frames, cameras, slow motion).
 
+pub mod blend;
 pub mod cycles;
 pub mod files;
 pub mod gltf;

@@ -6,8 +6,9 @@
 //! ([`Problem::fly`] and [`Problem::state_at`]: exact free flight, landings absorbed by the
 //! table), with a key at every timestep and one exactly at `t`, so that the animation
 //! shows at `t` exactly the shadow the solver scored. From `t` on, rapier3d continues the
-//! motion with collisions, landing and bouncing ([`crate::sim::continuation`]), by default for
-//! one second.
+//! motion with collisions, landing and bouncing ([`crate::sim::continuation`]) until every
+//! body is at rest on the table or the floor, or a cap (by default [`DEFAULT_MAX_AFTER`]
+//! seconds after `t`); [`Track::rest`] says which.
 
 use glam::{DQuat, DVec3};
 use serde::Serialize;
@@ -15,7 +16,7 @@ use serde::Serialize;
 use crate::evaluate::Problem;
 use crate::geometry::shape::Shape;
 use crate::scene::Launch;
-use crate::sim::continuation::{self, BodyState, ContinuationConfig};
+use crate::sim::continuation::{self, BodyState, ContinuationConfig, Rest, Until};
 
 /// The sampled flight of all occluders, one key per simulation step: what the animated
 /// glTF, `trajectory.csv` and Blender show.
@@ -32,13 +33,38 @@ pub struct Track {
     pub fps: f64,
     /// Keys from `t_index` on come from the rapier continuation.
     pub continuation_from: usize,
+    /// How the continuation ended: every body at rest, or stopped at the cap.
+    pub rest: Rest,
 }
 
-/// Default length of the continuation after `t` (s).
-pub const DEFAULT_AFTER: f64 = 1.0;
+impl Track {
+    /// The poses at any `time` (s): linear between keys for the origins, slerp for the
+    /// orientations (the glTF LINEAR rule); clamped to the first and last keys.
+    pub fn poses_at(&self, time: f64) -> Vec<(DVec3, DQuat)> {
+        let k = self.times.partition_point(|&x| x <= time);
+        if k == 0 {
+            return self.poses[0].clone();
+        }
+        if k == self.times.len() {
+            return self.poses[k - 1].clone();
+        }
+        let (t0, t1) = (self.times[k - 1], self.times[k]);
+        let s = (time - t0) / (t1 - t0);
+        self.poses[k - 1]
+            .iter()
+            .zip(&self.poses[k])
+            .map(|(a, b)| (a.0.lerp(b.0, s), a.1.slerp(b.1, s)))
+            .collect()
+    }
+}
 
-/// The motion of launch values `params` from 0 to `t + after`.
-pub fn track(problem: &Problem, params: &[f64], after: f64) -> Track {
+/// Default cap of the continuation after `t` (s): the motion runs until every body is at
+/// rest, or this long.
+pub const DEFAULT_MAX_AFTER: f64 = 30.0;
+
+/// The motion of launch values `params` from 0 until every body is at rest after `t`
+/// (see [`crate::sim::continuation::REST_SPEED_M_S`]), or `t + max_after`.
+pub fn track(problem: &Problem, params: &[f64], max_after: f64) -> Track {
     let scene = &problem.scene;
     let (t, dt) = (scene.t, scene.dt);
     let n = scene.occluders.len();
@@ -72,8 +98,15 @@ pub fn track(problem: &Problem, params: &[f64], after: f64) -> Track {
             }
         })
         .collect();
-    let steps = (after / dt).round().max(0.0) as usize;
-    let frames = continuation::simulate(scene, &start, t, steps, &ContinuationConfig::default());
+    let max_steps = (max_after / dt).round().max(0.0) as usize;
+    let frames = continuation::simulate(
+        scene,
+        &start,
+        t,
+        Until::Rest { max_steps },
+        &ContinuationConfig::default(),
+    );
+    out.rest = frames.rest;
     out.t_index = out.times.len();
     out.continuation_from = out.t_index;
     for (time, poses) in frames.times.into_iter().zip(frames.poses) {

@@ -2,12 +2,21 @@
 //! collisions, landing and bouncing. This is what exports animate after the exact flight.
 //!
 //! Main types: [`ContinuationConfig`] (engine tunables with units), [`BodyState`] (the
-//! exact state handed to rapier) and [`Frames`] (poses at every timestep).
+//! exact state handed to rapier), [`Until`] (a number of steps, or until every body is at
+//! rest) and [`Frames`] (poses at every timestep, and [`Rest`]: whether and when the
+//! motion ended).
 //!
 //! Data flow: [`simulate`] builds a rapier `PhysicsWorld` from the scene (one dynamic
 //! body per occluder with the mass properties we computed ourselves, the table as a fixed
 //! box, the receiver as a fixed half-space), sets each body's state, steps it at the
 //! scene's timestep and records every pose.
+//!
+//! **Rest.** A body is at rest when every point of it moves slower than
+//! [`REST_SPEED_M_S`] (1 cm/s), measured on the recorded poses as [`point_speed`] does;
+//! the motion is over once every body has been at rest for [`REST_HOLD_S`] (0.25 s, so
+//! that the top of a vertical throw does not count). rapier has no rolling resistance: a
+//! ball would roll on forever, so a body that touches anything slows down at
+//! `rolling_resistance * g` (and its spin in proportion, see [`ContinuationConfig`]).
 //!
 //! Two traps from the field notes are handled here:
 //! - rapier integrates with symplectic Euler per substep `h = dt / substeps`, so a body
@@ -22,7 +31,8 @@ use glam::{DQuat, DVec3, Vec3};
 use rapier3d::parry::math::Pose;
 use rapier3d::parry::shape::ConvexPolyhedron;
 use rapier3d::prelude::{
-    ColliderBuilder, MassProperties, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle, SharedShape,
+    ColliderBuilder, ColliderHandle, MassProperties, PhysicsWorld, RigidBodyBuilder,
+    RigidBodyHandle, SharedShape,
 };
 
 use crate::geometry::shape::Shape;
@@ -37,6 +47,12 @@ pub struct ContinuationConfig {
     pub restitution: f64,
     /// Coulomb friction coefficient of every contact (default 0.5).
     pub friction: f64,
+    /// Rolling resistance coefficient (dimensionless, default 0.1, a ball on carpet): a
+    /// body pressed against anything (a contact at most [`TOUCH_DISTANCE_M`] apart that
+    /// took an impulse in the last step) loses `rolling_resistance * |g| * dt` of speed
+    /// per step, and its angular speed the same divided by its bounding radius (a rolling
+    /// ball stays rolling). A 2.5 m/s ball stops within about 2.5 s. 0 turns it off.
+    pub rolling_resistance: f64,
 }
 
 impl Default for ContinuationConfig {
@@ -45,8 +61,46 @@ impl Default for ContinuationConfig {
             substeps: 4,
             restitution: 0.3,
             friction: 0.5,
+            rolling_resistance: 0.1,
         }
     }
+}
+
+/// A body is at rest when no point of it moves faster than this (m/s), as measured by
+/// [`point_speed`] between consecutive keys.
+pub const REST_SPEED_M_S: f64 = 0.01;
+/// The motion is over when every body has been at rest for this long (s): long enough
+/// that the top of a vertical throw (where the speed passes through zero) does not count.
+pub const REST_HOLD_S: f64 = 0.25;
+/// A contact this close (m, rapier's signed distance) counts as touching for the rolling
+/// resistance.
+pub const TOUCH_DISTANCE_M: f64 = 1e-3;
+
+/// How long [`simulate`] runs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Until {
+    /// Exactly this many timesteps.
+    Steps(usize),
+    /// Until every body has been at rest for [`REST_HOLD_S`], or `max_steps` timesteps.
+    Rest { max_steps: usize },
+}
+
+/// How the motion ended.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Rest {
+    /// Every body was at rest for [`REST_HOLD_S`] at the last key ([`Until::Rest`] only).
+    pub at_rest: bool,
+    /// When the last body came to rest (s), if every body was at rest at the last key.
+    pub since: Option<f64>,
+    /// Each body's [`point_speed`] over the last step (m/s); empty without a step.
+    pub last_speeds: Vec<f64>,
+}
+
+/// The fastest a point of a body can move between two poses `dt` apart (m/s): the
+/// origin's speed plus the rotation angle's rate times `radius`, the body's bounding
+/// radius about its origin (a point `p` moves at `v + w x (p - o)`).
+pub fn point_speed(a: (DVec3, DQuat), b: (DVec3, DQuat), dt: f64, radius: f64) -> f64 {
+    (a.0.distance(b.0) + a.1.angle_between(b.1) * radius) / dt
 }
 
 /// The exact state of one occluder handed to the engine.
@@ -69,15 +123,18 @@ pub struct Frames {
     pub poses: Vec<Vec<(DVec3, DQuat)>>,
     /// Velocities (COM, angular) at every step, corrected back to exact-flight meaning.
     pub velocities: Vec<Vec<(DVec3, DVec3)>>,
+    /// Whether and when the motion came to rest.
+    pub rest: Rest,
 }
 
 /// Simulate the scene's occluders with rapier from `start` (one state per occluder) at
-/// time `t0`, for `steps` timesteps of `scene.dt`. Frame 0 is the start state itself.
+/// time `t0`, in timesteps of `scene.dt`, for as long as `until` says. Frame 0 is the
+/// start state itself.
 pub fn simulate(
     scene: &Scene,
     start: &[BodyState],
     t0: f64,
-    steps: usize,
+    until: Until,
     cfg: &ContinuationConfig,
 ) -> Frames {
     assert_eq!(start.len(), scene.occluders.len());
@@ -105,6 +162,7 @@ pub fn simulate(
     world.insert(body, collider);
 
     let mut handles: Vec<RigidBodyHandle> = Vec::with_capacity(start.len());
+    let mut colliders: Vec<ColliderHandle> = Vec::with_capacity(start.len());
     for (o, s) in scene.occluders.iter().zip(start) {
         let mp = &o.mass;
         let mprops = MassProperties::with_principal_inertia_frame(
@@ -137,9 +195,19 @@ pub fn simulate(
         .density(0.0)
         .restitution(cfg.restitution as f32)
         .friction(cfg.friction as f32);
-        let (handle, _) = world.insert(body, collider);
+        let (handle, collider) = world.insert(body, collider);
         handles.push(handle);
+        colliders.push(collider);
     }
+    // Bounding radii about the centre of mass (for the rolling resistance's spin-down)
+    // and about the body origin (for the point speed of the rest test).
+    let com_radius: Vec<f64> = scene.occluders.iter().map(|o| o.bounding_radius).collect();
+    let origin_radius: Vec<f64> = scene
+        .occluders
+        .iter()
+        .map(|o| o.shape.bounding_radius(DVec3::ZERO))
+        .collect();
+    let slow_down = cfg.rolling_resistance.max(0.0) * scene.gravity.length() * scene.dt;
 
     let mut frames = Frames::default();
     let record = |world: &PhysicsWorld, frames: &mut Frames, time: f64| {
@@ -156,11 +224,74 @@ pub fn simulate(
         frames.velocities.push(vels);
     };
     record(&world, &mut frames, t0);
-    for k in 1..=steps {
+    let (max_steps, stop_at_rest) = match until {
+        Until::Steps(n) => (n, false),
+        Until::Rest { max_steps } => (max_steps, true),
+    };
+    let hold_steps = (REST_HOLD_S / scene.dt).ceil() as usize;
+    // Consecutive steps at which every body has been at rest.
+    let mut still = 0usize;
+    for k in 1..=max_steps {
         world.step();
+        if slow_down > 0.0 {
+            roll_resistance(&mut world, &handles, &colliders, &com_radius, slow_down);
+        }
         record(&world, &mut frames, t0 + k as f64 * scene.dt);
+        let speeds = last_speeds(&frames, &origin_radius, scene.dt);
+        if speeds.iter().all(|&s| s < REST_SPEED_M_S) {
+            still += 1;
+        } else {
+            still = 0;
+        }
+        frames.rest.last_speeds = speeds;
+        if stop_at_rest && still >= hold_steps {
+            frames.rest.at_rest = true;
+            frames.rest.since = Some(t0 + (k - still) as f64 * scene.dt);
+            break;
+        }
     }
     frames
+}
+
+/// Each body's [`point_speed`] between the last two recorded keys.
+fn last_speeds(frames: &Frames, radius: &[f64], dt: f64) -> Vec<f64> {
+    let n = frames.poses.len();
+    if n < 2 {
+        return Vec::new();
+    }
+    let (a, b) = (&frames.poses[n - 2], &frames.poses[n - 1]);
+    (0..radius.len())
+        .map(|i| point_speed(a[i], b[i], dt, radius[i]))
+        .collect()
+}
+
+/// The rolling resistance of [`ContinuationConfig::rolling_resistance`]: every awake body
+/// whose collider is pressed against another collider loses `slow_down` m/s of speed and
+/// `slow_down / radius` rad/s of spin (never past zero).
+fn roll_resistance(
+    world: &mut PhysicsWorld,
+    handles: &[RigidBodyHandle],
+    colliders: &[ColliderHandle],
+    com_radius: &[f64],
+    slow_down: f64,
+) {
+    for ((h, c), r) in handles.iter().zip(colliders).zip(com_radius) {
+        // Touching and pressed: a body leaving the table (a launch) gets no impulse.
+        let touching = world.narrow_phase.contact_pairs_with(*c).any(|p| {
+            p.total_impulse_magnitude() > 0.0
+                && p.find_deepest_contact()
+                    .is_some_and(|(_, contact)| f64::from(contact.dist) <= TOUCH_DISTANCE_M)
+        });
+        let body = &mut world.bodies[*h];
+        if !touching || body.is_sleeping() {
+            continue;
+        }
+        let shrink = |v: DVec3, by: f64| v * ((v.length() - by).max(0.0) / v.length().max(1e-300));
+        let v = shrink(body.linvel().as_dvec3(), slow_down);
+        let w = shrink(body.angvel().as_dvec3(), slow_down / r.max(1e-6));
+        body.set_linvel(v.as_vec3(), false);
+        body.set_angvel(w.as_vec3(), false);
+    }
 }
 
 /// Directions of the support points that the fallback hull is built from: a Fibonacci
@@ -319,7 +450,13 @@ mod tests {
             });
         }
         let steps = (scene.t / scene.dt).round() as usize;
-        let frames = simulate(&scene, &start, 0.0, steps, &ContinuationConfig::default());
+        let frames = simulate(
+            &scene,
+            &start,
+            0.0,
+            Until::Steps(steps),
+            &ContinuationConfig::default(),
+        );
         let mut worst_p: f64 = 0.0;
         let mut worst_q: f64 = 0.0;
         for (k, time) in frames.times.iter().enumerate() {
@@ -345,7 +482,7 @@ mod tests {
             &scene,
             &uncorrected,
             0.0,
-            steps,
+            Until::Steps(steps),
             &ContinuationConfig::default(),
         );
         let err = frames.poses[steps][0]
@@ -365,7 +502,13 @@ mod tests {
             velocity: DVec3::new(0.5, 0.0, 4.0),
             angular_velocity: DVec3::ZERO,
         }];
-        let frames = simulate(&scene, &start, 0.0, 180, &ContinuationConfig::default());
+        let frames = simulate(
+            &scene,
+            &start,
+            0.0,
+            Until::Steps(180),
+            &ContinuationConfig::default(),
+        );
         let lowest = frames
             .poses
             .iter()
@@ -374,5 +517,82 @@ mod tests {
         assert!(lowest > 0.3 - 0.02, "ball sank to {lowest}");
         let last = frames.poses.last().unwrap()[0].0;
         assert!(last.z < 0.35, "ball still in the air at {last}");
+    }
+
+    fn ball_on_table(velocity: DVec3, angular_velocity: DVec3) -> (Scene, [BodyState; 1]) {
+        let scene = scene_with(
+            r#"[{"name": "a", "shape": {"sphere": {"radius": 0.3}}, "position": [0, 0, 0.3], "mass": 5}]"#,
+        );
+        let start = [BodyState {
+            origin: DVec3::new(0.0, 0.0, 0.3),
+            orientation: DQuat::IDENTITY,
+            velocity,
+            angular_velocity,
+        }];
+        (scene, start)
+    }
+
+    /// A ball rolling at 2.5 m/s: without rolling resistance rapier lets it roll for
+    /// ever (still at speed after 20 s); with the default it comes to rest, and the rest
+    /// is real: the last keys do not move.
+    #[test]
+    fn a_rolling_ball_comes_to_rest_with_rolling_resistance_only() {
+        // Rolling without slipping about -y... v = w x r: w = (0, 2.5 / 0.3, 0) rolls +x.
+        let (scene, start) =
+            ball_on_table(DVec3::new(2.5, 0.0, 0.0), DVec3::new(0.0, 2.5 / 0.3, 0.0));
+        let until = Until::Rest {
+            max_steps: (20.0 / scene.dt) as usize,
+        };
+        let none = ContinuationConfig {
+            rolling_resistance: 0.0,
+            ..ContinuationConfig::default()
+        };
+        let frames = simulate(&scene, &start, 0.0, until, &none);
+        assert!(!frames.rest.at_rest);
+        assert!(frames.rest.since.is_none());
+        assert!(frames.rest.last_speeds[0] > 1.0, "{:?}", frames.rest);
+        assert_eq!(frames.times.len(), 1 + (20.0 / scene.dt) as usize);
+
+        let frames = simulate(&scene, &start, 0.0, until, &ContinuationConfig::default());
+        let since = frames.rest.since.expect("at rest");
+        assert!(frames.rest.at_rest);
+        assert!(since < 4.0, "at rest only after {since} s");
+        let last = frames.times.last().unwrap();
+        assert!(
+            (last - since - REST_HOLD_S).abs() <= scene.dt,
+            "{last} {since}"
+        );
+        let n = frames.poses.len();
+        let r = scene.occluders[0].shape.bounding_radius(DVec3::ZERO);
+        for k in n - (REST_HOLD_S / scene.dt) as usize..n {
+            let s = point_speed(frames.poses[k - 1][0], frames.poses[k][0], scene.dt, r);
+            assert!(s < REST_SPEED_M_S, "key {k}: {s} m/s");
+        }
+        // It rolled on the table, not through it.
+        let end = frames.poses[n - 1][0].0;
+        assert!(end.x > 1.0 && (end.z - 0.3).abs() < 0.01, "{end}");
+    }
+
+    /// The top of a vertical throw, where the speed passes through zero, is not rest:
+    /// the ball comes to rest only after it has landed.
+    #[test]
+    fn the_top_of_a_throw_is_not_rest() {
+        let (scene, start) = ball_on_table(DVec3::new(0.0, 0.0, 3.0), DVec3::ZERO);
+        let frames = simulate(
+            &scene,
+            &start,
+            0.0,
+            Until::Rest {
+                max_steps: (10.0 / scene.dt) as usize,
+            },
+            &ContinuationConfig::default(),
+        );
+        let since = frames.rest.since.expect("at rest");
+        let flight = 2.0 * 3.0 / 9.81;
+        assert!(
+            since > flight,
+            "at rest at {since} s, before landing at {flight} s"
+        );
+        assert!(frames.rest.last_speeds[0] < REST_SPEED_M_S);
     }
 }

@@ -1,21 +1,22 @@
 //! The cross-check with Blender (bpy, Cycles): the Cycles shadow at t matches the
 //! rasterizer, Blender imports the glTF with its animation, light, cameras and frame
-//! range, and the video renders. Every test here needs Blender's bpy in `.venv-blender`
+//! range, and the glb renders right as imported (the .blend and the video: `blend`). Every test here needs Blender's bpy in `.venv-blender`
 //! (`bash blender/setup_venv.sh`), so they are ignored by plain `cargo test`;
 //! `scripts/test.sh` installs bpy and runs them (`cargo test -- --include-ignored`).
 
-use std::process::Command;
-
 use bsa::evaluate::Problem;
 
-use crate::util::{bsa, example_scenes, quick_solve, require, root, tmpdir};
+use crate::util::{
+    blender_script, bsa, example_scenes, last_key_time, quick_solve, require, root,
+    shared_quick_solve, tmpdir,
+};
 
 #[test]
 #[ignore = "needs Blender's bpy in .venv-blender (bash blender/setup_venv.sh); run by scripts/test.sh"]
 fn cycles_mask_matches_the_rasterizer() {
     for scene in example_scenes() {
         let name = scene.file_name().unwrap().to_str().unwrap().to_string();
-        let out = quick_solve(&scene, &format!("cycles-{name}"));
+        let out = shared_quick_solve(&name);
         let (ok, stdout, err) = bsa(&["validate", out.to_str().unwrap()]);
         assert!(ok, "{err}");
         let v: serde_json::Value =
@@ -37,11 +38,18 @@ fn import_keeps_animation_light_cameras_and_frame_range() {
     );
     let out = quick_solve(&root().join("scenes/mickey"), "blender-import");
     let glb = out.join("mickey.glb");
-    let v = run_script("check_import.py", &["--glb", glb.to_str().unwrap()]);
+    let v = blender_script("check_import.py", &["--glb", glb.to_str().unwrap()]);
     assert_eq!(v["fps"].as_f64().unwrap(), 60.0);
     assert_eq!(v["frame_t"].as_f64().unwrap(), 72.0);
     assert_eq!(v["frame_start"], 0);
-    assert_eq!(v["frame_end"], 132, "t + 1 s at 60 fps");
+    // The animation runs until every body is at rest: its last key is the last row of
+    // trajectory.csv.
+    let last = last_key_time(&out);
+    assert_eq!(
+        v["frame_end"],
+        (last * 60.0).round() as i64,
+        "last key at {last} s"
+    );
     assert_eq!(v["cameras"]["camera_shadow"]["type"], "ORTHO");
     assert!(
         (v["cameras"]["camera_shadow"]["ortho_scale"]
@@ -101,55 +109,6 @@ fn import_keeps_animation_light_cameras_and_frame_range() {
 
 #[test]
 #[ignore = "needs Blender's bpy in .venv-blender (bash blender/setup_venv.sh); run by scripts/test.sh"]
-fn video_of_mickey_renders_an_mp4() {
-    let out = quick_solve(&root().join("scenes/mickey"), "video");
-    let mp4 = out.join("short.mp4");
-    let (ok, _, err) = bsa(&[
-        "video",
-        out.to_str().unwrap(),
-        "--out",
-        mp4.to_str().unwrap(),
-        "--samples",
-        "1",
-        "--width",
-        "160",
-        "--height",
-        "120",
-        "--seconds",
-        "0.2",
-    ]);
-    assert!(ok, "{err}");
-    let bytes = std::fs::read(&mp4).unwrap();
-    assert!(
-        bytes.len() > 1000 && &bytes[4..8] == b"ftyp",
-        "not an MP4 ({} bytes)",
-        bytes.len()
-    );
-}
-
-/// Run `blender/<script> -- <args>` with the bpy venv; its `BSA_RESULT` line as JSON.
-fn run_script(script: &str, args: &[&str]) -> serde_json::Value {
-    require(
-        &root().join(".venv-blender/bin/python"),
-        "bash blender/setup_venv.sh",
-    );
-    let o = Command::new(root().join(".venv-blender/bin/python"))
-        .arg(root().join("blender").join(script))
-        .arg("--")
-        .args(args)
-        .output()
-        .expect("the bpy virtualenv (bash blender/setup_venv.sh)");
-    let stdout = String::from_utf8_lossy(&o.stdout);
-    let line = stdout
-        .lines()
-        .rev()
-        .find_map(|l| l.strip_prefix("BSA_RESULT "))
-        .unwrap_or_else(|| panic!("{}", String::from_utf8_lossy(&o.stderr)));
-    serde_json::from_str(line).unwrap()
-}
-
-#[test]
-#[ignore = "needs Blender's bpy in .venv-blender (bash blender/setup_venv.sh); run by scripts/test.sh"]
 fn glb_renders_the_picture_as_imported() {
     // Default importer settings, the imported light and materials, Cycles from the shadow
     // camera at t: the receiver is lit (not shadowed by the table top in its plane), the
@@ -160,7 +119,7 @@ fn glb_renders_the_picture_as_imported() {
     assert!(ok, "{err}");
     let glb = out.join("mickey.glb");
     let target = root().join("scenes/mickey/target.png");
-    let v = run_script(
+    let v = blender_script(
         "check_render.py",
         &[
             "--glb",

@@ -1,6 +1,7 @@
 //! The command line end to end: `bsa check`, `solve` with every output file, `eval`
-//! reading a solution back, and clear errors from `export`, `validate` and `video` when
-//! their input is missing, corrupt or belongs to another scene.
+//! reading a solution back, and clear errors from `export`, `validate`, `blend` and
+//! `video` when their input is missing, corrupt or belongs to another scene, or their
+//! options are out of range.
 
 use std::path::Path;
 use std::process::Command;
@@ -136,7 +137,7 @@ fn solve_and_eval_from_the_command_line() {
 fn bad_input_to_export_validate_and_video() {
     // Missing solution.
     let empty = tmpdir("export-empty");
-    for cmd in ["export", "validate", "video"] {
+    for cmd in ["export", "validate", "blend", "video"] {
         let (ok, _, err) = bsa(&[cmd, empty.to_str().unwrap()]);
         assert!(
             !ok && err.contains("no solution.json") && !err.contains("panicked"),
@@ -181,15 +182,13 @@ fn bad_input_to_export_validate_and_video() {
             );
         }
     }
-    // A corrupt .glb.
+    // A corrupt .glb (`blend` and `video` export it again from the solution first).
     std::fs::write(out.join("mickey.glb"), b"glTF garbage").unwrap();
-    for cmd in ["validate", "video"] {
-        let (ok, _, err) = bsa(&[cmd, out.to_str().unwrap()]);
-        assert!(
-            !ok && err.contains("not a valid glTF") && !err.contains("panicked"),
-            "{cmd}: {err}"
-        );
-    }
+    let (ok, _, err) = bsa(&["validate", out.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("not a valid glTF") && !err.contains("panicked"),
+        "{err}"
+    );
     // A missing .glb.
     std::fs::remove_file(out.join("mickey.glb")).unwrap();
     let (ok, _, err) = bsa(&["validate", out.to_str().unwrap()]);
@@ -198,6 +197,51 @@ fn bad_input_to_export_validate_and_video() {
     std::fs::write(out.join("solution.json"), "[1, 2").unwrap();
     let (ok, _, err) = bsa(&["export", out.to_str().unwrap()]);
     assert!(!ok && err.contains("not a valid solution file"), "{err}");
+}
+
+/// `blend` and `video` refuse bad options with the option's name, before any work.
+#[test]
+fn bad_options_of_blend_and_video() {
+    let d = tmpdir("blend-options");
+    let dir = d.to_str().unwrap();
+    for (args, says) in [
+        (vec!["blend", dir, "--fps", "0"], "--fps must be"),
+        (vec!["blend", dir, "--fps", "1000"], "--fps must be"),
+        (
+            vec!["blend", dir, "--resolution", "1920"],
+            "--resolution must be WIDTHxHEIGHT",
+        ),
+        (
+            vec!["blend", dir, "--resolution", "axb"],
+            "--resolution must be WIDTHxHEIGHT",
+        ),
+        (
+            vec!["blend", dir, "--resolution", "12x5"],
+            "each side must be 16 to 16384",
+        ),
+        (
+            vec!["video", dir, "--resolution", "161x90"],
+            "even width and height",
+        ),
+        (
+            vec!["video", dir, "--samples", "0"],
+            "--samples must be at least 1",
+        ),
+        (
+            vec!["video", dir, "--seconds", "-1"],
+            "--seconds must be positive",
+        ),
+        (
+            vec!["video", dir, "--blend", "/nonexistent/a.blend"],
+            "--blend /nonexistent/a.blend: no such file",
+        ),
+    ] {
+        let (ok, _, err) = bsa(&args);
+        assert!(
+            !ok && err.contains(says) && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
+    }
 }
 
 /// Runs `bsa` in `cwd`: (success, stdout, stderr).

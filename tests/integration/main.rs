@@ -4,7 +4,9 @@
 //! - `scene_errors`: bad scenes get clear errors that name the file and the field;
 //! - `solver`: determinism, resume, interrupts, strategies, the golden shadow, Mickey;
 //! - `exports`: the glTF poses and tables, the Khronos validator, the error budget;
-//! - `blender`: the Cycles mask, the Blender import and the video;
+//! - `blender`: the Cycles mask, the Blender import, the glb rendered as imported;
+//! - `blend`: `bsa blend` and `bsa video` (t on a whole frame at any fps, the view
+//!   camera, EEVEE, slow motion, the contact sheet);
 //! - `robust`: the audit of issue #13 (bad magnitudes, meshes, interrupted and failing
 //!   solves, the lock);
 //! - `fuzz`: scene mutations generated from the schema, run through `check` and a short
@@ -16,6 +18,7 @@
 //! (`cargo test -- --include-ignored`, as `scripts/test.sh` does after installing both)
 //! they run for real and a missing tool fails them.
 
+mod blend;
 mod blender;
 mod cli;
 mod exports;

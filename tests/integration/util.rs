@@ -2,8 +2,10 @@
 //! folders, variants of the Mickey scene, quick solves through the command line, and the
 //! check that a tool an ignored test needs is installed.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// The repository root, where the tests run `bsa`.
 pub fn root() -> PathBuf {
@@ -112,4 +114,65 @@ pub fn require(path: &Path, install: &str) {
         "{} is missing: {install} (scripts/test.sh does it)",
         path.display()
     );
+}
+
+/// `make()`'s folder, made once per test process under `key` and shared by the tests
+/// that ask for it (they only add files of their own to it).
+fn shared(key: String, make: impl FnOnce() -> PathBuf) -> PathBuf {
+    type Cells = BTreeMap<String, Arc<OnceLock<PathBuf>>>;
+    static CELLS: Mutex<Cells> = Mutex::new(BTreeMap::new());
+    let cell = CELLS.lock().unwrap().entry(key).or_default().clone();
+    cell.get_or_init(make).clone()
+}
+
+/// [`quick_solve`] of the example `scenes/<name>`, once per test process.
+pub fn shared_quick_solve(name: &str) -> PathBuf {
+    shared(format!("quick-{name}"), || {
+        quick_solve(
+            &root().join("scenes").join(name),
+            &format!("shared-quick-{name}"),
+        )
+    })
+}
+
+/// The full solve of the example `scenes/<name>` (its own stages, as the README's
+/// command), once per test process: the pictures the examples really make.
+pub fn shared_full_solve(name: &str) -> PathBuf {
+    shared(format!("full-{name}"), || {
+        let out = tmpdir(&format!("shared-full-{name}")).join("out");
+        let scene = format!("scenes/{name}");
+        let (ok, _, err) = bsa(&["solve", &scene, "--out", out.to_str().unwrap(), "--quiet"]);
+        assert!(ok, "{err}");
+        out
+    })
+}
+
+/// Runs `blender/<script> -- <args>` with the bpy venv (which it requires) and returns
+/// the JSON of its `BSA_RESULT` line, refusing a reported error.
+pub fn blender_script(script: &str, args: &[&str]) -> serde_json::Value {
+    let python = root().join(".venv-blender/bin/python");
+    require(&python, "bash blender/setup_venv.sh");
+    let o = Command::new(python)
+        .arg(root().join("blender").join(script))
+        .arg("--")
+        .args(args)
+        .output()
+        .expect("the bpy virtualenv (bash blender/setup_venv.sh)");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let line = stdout
+        .lines()
+        .rev()
+        .find_map(|l| l.strip_prefix("BSA_RESULT "))
+        .unwrap_or_else(|| panic!("{script}: {}", String::from_utf8_lossy(&o.stderr)));
+    let v: serde_json::Value = serde_json::from_str(line).unwrap();
+    assert!(v.get("error").is_none(), "{script}: {v}");
+    v
+}
+
+/// The time of the last key of an output folder's trajectory.csv (s): the end of the
+/// animation, every body at rest.
+pub fn last_key_time(dir: &Path) -> f64 {
+    let traj = std::fs::read_to_string(dir.join("trajectory.csv")).unwrap();
+    let last = traj.lines().last().unwrap();
+    last.split(',').next().unwrap().parse().unwrap()
 }

@@ -11,12 +11,16 @@ use super::*;
 pub(super) struct MeshData {
     pub(super) positions: Vec<DVec3>,
     pub(super) normals: Vec<DVec3>,
+    /// Texture coordinates (glTF's: origin at the image's top left), one per position.
+    pub(super) uvs: Vec<[f64; 2]>,
     pub(super) indices: Vec<u32>,
 }
 
 pub(super) struct Builder {
     pub(super) root: json::Root,
     pub(super) bin: Vec<u8>,
+    /// The wood materials made so far (one each, shared by the objects of that wood).
+    woods: Vec<(Wood, Index<json::Material>)>,
 }
 
 impl Builder {
@@ -35,6 +39,7 @@ impl Builder {
         Builder {
             root,
             bin: Vec::new(),
+            woods: Vec::new(),
         }
     }
 
@@ -143,6 +148,58 @@ impl Builder {
         })
     }
 
+    /// The material of a wood: its procedural texture (a PNG in the binary buffer,
+    /// repeated) as base colour through `TEXCOORD_0`; made once, then shared.
+    pub(super) fn wood(&mut self, wood: Wood) -> Index<json::Material> {
+        if let Some((_, m)) = self.woods.iter().find(|(w, _)| *w == wood) {
+            return *m;
+        }
+        let name = wood.name();
+        let view = self.view(&wood.png(), None);
+        let image = self.root.push(json::Image {
+            buffer_view: Some(view),
+            mime_type: Some(json::image::MimeType("image/png".into())),
+            name: Some(name.into()),
+            uri: None,
+            extensions: None,
+            extras: Default::default(),
+        });
+        let sampler = self.root.push(json::texture::Sampler {
+            mag_filter: Some(Valid(json::texture::MagFilter::Linear)),
+            min_filter: Some(Valid(json::texture::MinFilter::LinearMipmapLinear)),
+            name: None,
+            wrap_s: Valid(json::texture::WrappingMode::Repeat),
+            wrap_t: Valid(json::texture::WrappingMode::Repeat),
+            extensions: None,
+            extras: Default::default(),
+        });
+        let texture = self.root.push(json::Texture {
+            name: Some(name.into()),
+            sampler: Some(sampler),
+            source: image,
+            extensions: None,
+            extras: Default::default(),
+        });
+        let material = self.root.push(json::Material {
+            name: Some(name.into()),
+            pbr_metallic_roughness: json::material::PbrMetallicRoughness {
+                base_color_factor: json::material::PbrBaseColorFactor([1.0; 4]),
+                base_color_texture: Some(json::texture::Info {
+                    index: texture,
+                    tex_coord: 0,
+                    extensions: None,
+                    extras: Default::default(),
+                }),
+                metallic_factor: json::material::StrengthFactor(0.0),
+                roughness_factor: json::material::StrengthFactor(wood.roughness()),
+                ..Default::default()
+            },
+            ..Default::default()
+        });
+        self.woods.push((wood, material));
+        material
+    }
+
     /// One triangle-list primitive, its data converted to glTF axes.
     pub(super) fn mesh(
         &mut self,
@@ -172,10 +229,23 @@ impl Builder {
             false,
             Some(json::buffer::Target::ArrayBuffer),
         );
+        let uv: Vec<f32> = data
+            .uvs
+            .iter()
+            .flat_map(|&[u, v]| [u as f32, v as f32])
+            .collect();
+        let uvs = self.float_accessor(
+            &uv,
+            json::accessor::Type::Vec2,
+            2,
+            false,
+            Some(json::buffer::Target::ArrayBuffer),
+        );
         let indices = self.index_accessor(&data.indices);
         let mut attributes = BTreeMap::new();
         attributes.insert(Valid(json::mesh::Semantic::Positions), positions);
         attributes.insert(Valid(json::mesh::Semantic::Normals), normals);
+        attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), uvs);
         Ok(self.root.push(json::Mesh {
             extensions: None,
             extras: Default::default(),

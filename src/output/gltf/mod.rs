@@ -33,10 +33,13 @@ use crate::scene::Scene;
 mod build;
 mod meshes;
 mod read;
+mod wood;
 
 use build::*;
 use meshes::*;
 pub use read::read_poses_at;
+use wood::Wood;
+pub use wood::WOOD_TILE_M;
 
 /// Value of `asset.generator` and of the scene extras' `generator`.
 pub const GENERATOR: &str = "ballistic-shadow-art";
@@ -197,7 +200,24 @@ pub fn write_glb_with_launches(
                 d
             }
         };
-        let material = b.material(&occ.name, occluder_colour(i), 0.5);
+        // Blocks are maple, meshes (the chess pieces) boxwood, each showing its own part
+        // of the shared texture; balls keep a colour of their own.
+        let mut data = data;
+        let material = match &occ.shape {
+            Shape::Sphere { .. } => b.material(&occ.name, occluder_colour(i), 0.5),
+            Shape::Cuboid { .. } => b.wood(Wood::Maple),
+            Shape::Mesh(_) => b.wood(Wood::Boxwood),
+        };
+        if !matches!(occ.shape, Shape::Sphere { .. }) {
+            let golden = 0.618_033_988_749_895;
+            offset_uvs(
+                &mut data,
+                [
+                    (i as f64 * golden).fract(),
+                    (i as f64 * golden * golden).fract(),
+                ],
+            );
+        }
         let mesh = b.mesh(&occ.name, &data, material)?;
         let (o, q) = traj.poses[traj.t_index][i];
         let extras = match launches.map(|l| &l[i]) {
@@ -229,6 +249,7 @@ pub fn write_glb_with_launches(
         rc.u * (RECEIVER_MARGIN * rc.width / 2.0),
         rc.v * (RECEIVER_MARGIN * rc.height / 2.0),
         rc.normal,
+        RECEIVER_MARGIN,
     );
     let mesh = b.mesh("receiver", &quad, white)?;
     scene_nodes.push(b.root.push(json::Node {

@@ -81,6 +81,7 @@ fn ballistic(scene: &Scene) -> Track {
         t_index: n_t,
         fps: 1.0 / dt,
         continuation_from: n_t,
+        rest: Default::default(),
     }
 }
 
@@ -412,7 +413,15 @@ fn crease_normals_keep_a_cube_flat() {
         panic!()
     };
     let d = trimesh_mesh(m);
-    assert_eq!(d.positions.len(), 24);
+    // One normal per corner and face: 24 (position, normal) pairs; the cylindrical
+    // texture's seam splits a few more vertices, with the same normals.
+    let pairs: HashSet<[u64; 6]> = d
+        .positions
+        .iter()
+        .zip(&d.normals)
+        .map(|(p, n)| [p.x, p.y, p.z, n.x, n.y, n.z].map(f64::to_bits))
+        .collect();
+    assert_eq!(pairs.len(), 24);
     assert_eq!(d.indices.len(), 36);
     for n in &d.normals {
         assert!((n.abs().max_element() - 1.0).abs() < 1e-12);
@@ -479,4 +488,100 @@ fn occluder_nodes_carry_extras_and_launches_must_match() {
         write_glb_with_launches(&scene, &traj, Some(&[])),
         Err(GltfError::LaunchCount { got: 0, .. })
     ));
+}
+
+/// Every mesh carries texture coordinates, one per vertex; blocks are maple and meshes
+/// boxwood, both textured through `TEXCOORD_0`; balls keep a colour of their own.
+#[test]
+fn meshes_have_texture_coordinates_and_wood_materials() {
+    let scene = shapes_scene();
+    let glb = write_glb(&scene, &ballistic(&scene)).unwrap();
+    let g = doc(&glb);
+    let mut materials = HashSet::new();
+    for mesh in g.meshes() {
+        for p in mesh.primitives() {
+            let pos = p.get(&gltf::Semantic::Positions).unwrap();
+            let uv = p.get(&gltf::Semantic::TexCoords(0)).expect("TEXCOORD_0");
+            assert_eq!(uv.count(), pos.count(), "{:?}", mesh.name());
+            let m = p.material();
+            let textured = m.pbr_metallic_roughness().base_color_texture().is_some();
+            let name = mesh.name().unwrap().to_string();
+            materials.insert((name, m.name().unwrap().to_string(), textured));
+        }
+    }
+    // shapes_scene: a box (occluder 0), a mesh (1) and a ball (2).
+    let o = &scene.occluders;
+    for (i, material, textured) in [(0, "maple", true), (1, "boxwood", true)] {
+        assert!(
+            materials.contains(&(o[i].name.clone(), material.to_string(), textured)),
+            "{materials:?}"
+        );
+    }
+    assert!(
+        materials.contains(&(o[2].name.clone(), o[2].name.clone(), false)),
+        "{materials:?}"
+    );
+    assert_eq!(g.textures().count(), 2);
+    for image in g.images() {
+        let gltf::image::Source::View { mime_type, .. } = image.source() else {
+            panic!("an embedded image");
+        };
+        assert_eq!(mime_type, "image/png");
+    }
+}
+
+/// Box faces: texture coordinates in tiles of `WOOD_TILE_M`, `u` along the longest axis
+/// in the face (the grain). Meshes: cylindrical about z, and no triangle stretched across
+/// the seam. The receiver: 0..1 over the picture's rectangle, top left at (0, 0).
+#[test]
+fn texture_coordinates_follow_the_grain_and_the_picture() {
+    let h = DVec3::new(0.14, 0.035, 0.0175);
+    let d = cuboid_mesh(h);
+    for face in 0..6 {
+        let c = &d.uvs[4 * face..4 * face + 4];
+        let n = d.normals[4 * face];
+        let span = |k: usize| {
+            c.iter().map(|uv| uv[k]).fold(f64::NEG_INFINITY, f64::max)
+                - c.iter().map(|uv| uv[k]).fold(f64::INFINITY, f64::min)
+        };
+        // The face's two extents, longest first.
+        let mut ext: Vec<f64> = (0..3)
+            .filter(|&k| n[k] == 0.0)
+            .map(|k| 2.0 * h[k])
+            .collect();
+        ext.sort_by(|a, b| b.total_cmp(a));
+        assert!(
+            (span(0) - ext[0] / WOOD_TILE_M).abs() < 1e-12,
+            "face {face}"
+        );
+        assert!(
+            (span(1) - ext[1] / WOOD_TILE_M).abs() < 1e-12,
+            "face {face}"
+        );
+    }
+
+    let scene = crate::scene::load(&root_dir().join("scenes/thinker")).unwrap();
+    let Shape::Mesh(m) = &scene.occluders[0].shape else {
+        panic!("the king is a mesh")
+    };
+    let d = trimesh_mesh(m);
+    assert_eq!(d.uvs.len(), d.positions.len());
+    let around = d.uvs.iter().map(|uv| uv[1]).fold(0.0, f64::max);
+    for tri in d.indices.chunks(3) {
+        let v: Vec<f64> = tri.iter().map(|&i| d.uvs[i as usize][1]).collect();
+        let spread = v.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b))
+            - v.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+        assert!(spread < 0.5 * around, "a triangle across the seam: {v:?}");
+        for &i in tri {
+            let (p, uv) = (d.positions[i as usize], d.uvs[i as usize]);
+            assert!((uv[0] - p.z / WOOD_TILE_M).abs() < 1e-12);
+        }
+    }
+
+    let q = quad_mesh(DVec3::X * 3.0, DVec3::Y * 2.25, DVec3::Z, 1.5);
+    for (p, uv) in q.positions.iter().zip(&q.uvs) {
+        // The picture is 4 x 3 m: x from -2 to 2 maps to 0..1, y from 1.5 (top) to -1.5.
+        assert!((uv[0] - (p.x + 2.0) / 4.0).abs() < 1e-12, "{p} {uv:?}");
+        assert!((uv[1] - (1.5 - p.y) / 3.0).abs() < 1e-12, "{p} {uv:?}");
+    }
 }

@@ -7,6 +7,7 @@
 //! - [`difference_image`]: four-colour comparison of two masks.
 //! - [`plot`]: the convergence plot (the paper's Figure 7) and the error budget's
 //!   histogram and tolerance grid, drawn with `plotters` as PNG and SVG.
+//! - [`sheet`]: the contact sheet of a film (`bsa video`): its stills in a grid, labelled.
 //!
 //! Text is drawn with DejaVu Sans, embedded in the binary, so that no system font
 //! library is needed at build or run time. Nothing here touches the filesystem.
@@ -15,6 +16,7 @@ use image::{GrayImage, Luma, Rgb, RgbImage};
 use plotters::prelude::*;
 
 pub mod plot;
+pub mod sheet;
 
 /// Why a picture could not be drawn.
 #[derive(Debug, thiserror::Error)]
