@@ -4,7 +4,8 @@
 use glam::{DVec2, DVec3};
 
 use super::raw::RawScene;
-use super::{Hint, Occluder, Receiver};
+use super::{Hint, Occluder, Receiver, Table};
+use crate::geometry::distance::{signed_distance, ContactShape};
 use crate::shadow::raster::ShadowCamera;
 
 /// Which occluders have an explicit `start_velocity` (those are never re-aimed).
@@ -31,6 +32,9 @@ pub(super) struct Aim<'a> {
     pub gravity: DVec3,
     /// How much higher than its start the hint point is at `t` (m).
     pub rise: f64,
+    /// With free launch positions, the table a body may be moved on: under its aim point
+    /// (launched straight up) where it fits.
+    pub free_on: Option<&'a Table>,
 }
 
 impl Aim<'_> {
@@ -43,10 +47,12 @@ impl Aim<'_> {
             t,
             gravity,
             rise,
+            free_on,
         } = *self;
         let n = receiver.normal;
         let light_height = (camera.light - receiver.center).dot(n);
-        for (i, o) in occ.iter_mut().enumerate() {
+        for i in 0..occ.len() {
+            let o = &occ[i];
             if !o.launched || explicit[i] {
                 continue;
             }
@@ -60,7 +66,7 @@ impl Aim<'_> {
             let wsum: f64 = mine.iter().map(|h| h.weight).sum();
             let pixel = mine.iter().map(|h| h.pixel * h.weight).sum::<DVec2>() / wsum;
             let point = mine.iter().map(|h| h.point * h.weight).sum::<DVec3>() / wsum;
-            let com0 = o.launch_com();
+            let mut com0 = o.launch_com();
             // Offset from the centre of mass to the (mean) hint point, in the launch orientation.
             let offset = o.orientation * (point - o.mass.local_com);
             let on_plane = camera.pixel_to_world(pixel.x, pixel.y);
@@ -72,6 +78,14 @@ impl Aim<'_> {
             let s = h / light_height;
             let hint_at_t = on_plane + s * (camera.light - on_plane);
             let com_t = hint_at_t - offset;
+            if let Some(table) = free_on {
+                let under = DVec3::new(com_t.x, com_t.y, com0.z);
+                if let Some(spot) = free_spot(occ, i, under, table) {
+                    occ[i].position += spot - com0;
+                    com0 = spot;
+                }
+            }
+            let o = &mut occ[i];
             let v = (com_t - com0 - 0.5 * gravity * t * t) / t;
             // Absurd hint values can overflow; keep the straight-up start then.
             if v.is_finite() {
@@ -79,6 +93,50 @@ impl Aim<'_> {
             }
         }
     }
+}
+
+/// The nearest place for occluder `i`'s centre of mass to `want` (same height) where it
+/// fits on the table: `want` itself, else the first free one on rings of growing radius
+/// (half its bounding radius apart, 16 places a ring, up to 8 rings).
+fn free_spot(occ: &[Occluder], i: usize, want: DVec3, table: &Table) -> Option<DVec3> {
+    let o = &occ[i];
+    let step = 0.5 * o.bounding_radius;
+    let origin_of = |com: DVec3| o.position + (com - o.launch_com());
+    std::iter::once(want)
+        .chain((1..=8).flat_map(|ring| {
+            (0..16).map(move |k| {
+                let a = std::f64::consts::TAU * k as f64 / 16.0;
+                want + ring as f64 * step * DVec3::new(a.cos(), a.sin(), 0.0)
+            })
+        }))
+        .find(|&com| fits(occ, i, origin_of(com), table))
+}
+
+/// Whether occluder `i` moved to `position` stays on the table's top and clear of every
+/// other occluder (by a millimetre).
+fn fits(occ: &[Occluder], i: usize, position: DVec3, table: &Table) -> bool {
+    let o = &occ[i];
+    let c = position + o.orientation * o.mass.local_com;
+    let d = (c - table.center).abs();
+    if !(d.x + o.bounding_radius <= table.half_extents.x
+        && d.y + o.bounding_radius <= table.half_extents.y
+        && position.is_finite())
+    {
+        return false;
+    }
+    let mine = ContactShape::new(&o.shape);
+    occ.iter().enumerate().all(|(j, p)| {
+        j == i
+            || c.distance(p.launch_com()) > o.bounding_radius + p.bounding_radius + 1e-3
+            || signed_distance(
+                &mine,
+                position,
+                o.orientation,
+                &ContactShape::new(&p.shape),
+                p.position,
+                p.orientation,
+            ) > 1e-3
+    })
 }
 
 /// The automatic sequential order: largest occluders first, since they fix most of the
