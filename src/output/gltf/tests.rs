@@ -81,6 +81,7 @@ fn ballistic(scene: &Scene) -> Track {
         t_index: n_t,
         fps: 1.0 / dt,
         continuation_from: n_t,
+        instant_indices: vec![n_t],
     }
 }
 
