@@ -56,16 +56,9 @@ impl Aim<'_> {
             if !o.launched || explicit[i] {
                 continue;
             }
-            let mine: Vec<&Hint> = hints
-                .iter()
-                .filter(|h| h.occluder == i && h.weight > 0.0)
-                .collect();
-            if mine.is_empty() {
+            let Some((pixel, point)) = mean_hint(hints, i) else {
                 continue;
-            }
-            let wsum: f64 = mine.iter().map(|h| h.weight).sum();
-            let pixel = mine.iter().map(|h| h.pixel * h.weight).sum::<DVec2>() / wsum;
-            let point = mine.iter().map(|h| h.point * h.weight).sum::<DVec3>() / wsum;
+            };
             let mut com0 = o.launch_com();
             // Offset from the centre of mass to the (mean) hint point, in the launch orientation.
             let offset = o.orientation * (point - o.mass.local_com);
@@ -112,8 +105,81 @@ fn free_spot(occ: &[Occluder], i: usize, want: DVec3, table: &Table) -> Option<D
         .find(|&com| fits(occ, i, origin_of(com), table))
 }
 
+impl Aim<'_> {
+    /// With free positions, for the occluders hinted both in this picture (at `self.t`,
+    /// aimed by [`Aim::apply`] already) and in a later one (`later_hints` at `later_t`):
+    /// move the launch across the table so that a straight launch meets both aim points
+    /// in the horizontal (its vertical launch and so its heights are this picture's).
+    pub(super) fn apply_between(
+        &self,
+        later_t: f64,
+        later_hints: &[Hint],
+        occ: &mut [Occluder],
+        hints: &[Hint],
+        explicit: &[bool],
+    ) {
+        let Some(table) = self.free_on else {
+            return;
+        };
+        let (t, g) = (self.t, self.gravity);
+        let n = self.receiver.normal;
+        let light_height = (self.camera.light - self.receiver.center).dot(n);
+        for i in 0..occ.len() {
+            let o = &occ[i];
+            if !o.launched || explicit[i] || mean_hint(hints, i).is_none() {
+                continue;
+            }
+            let Some((pixel, point)) = mean_hint(later_hints, i) else {
+                continue;
+            };
+            let com0 = o.launch_com();
+            let v = o.start_velocity;
+            let at = |s: f64| com0 + v * s + 0.5 * g * s * s;
+            let offset = o.orientation * (point - o.mass.local_com);
+            // The later aim point: on its hint's ray, at the height the launch has then.
+            let h = (at(later_t) + offset - self.receiver.center).dot(n);
+            let h = h.clamp(0.05 * light_height, 0.9 * light_height);
+            let on_plane = self.camera.pixel_to_world(pixel.x, pixel.y);
+            let later = on_plane + h / light_height * (self.camera.light - on_plane) - offset;
+            let now = at(t);
+            let mut drift = (later - now) / (later_t - t);
+            drift.z = 0.0;
+            let want = now - drift * t;
+            let want = DVec3::new(want.x, want.y, com0.z);
+            if let Some(spot) = free_spot(occ, i, want, table) {
+                let o = &mut occ[i];
+                let v = (now - spot - 0.5 * g * t * t) / t;
+                if v.is_finite() {
+                    o.position += spot - com0;
+                    o.start_velocity = v;
+                }
+            }
+        }
+    }
+}
+
+/// The weighted mean pixel and body point of occluder `i`'s hints, if it has any.
+fn mean_hint(hints: &[Hint], i: usize) -> Option<(DVec2, DVec3)> {
+    let mine: Vec<&Hint> = hints
+        .iter()
+        .filter(|h| h.occluder == i && h.weight > 0.0)
+        .collect();
+    if mine.is_empty() {
+        return None;
+    }
+    let wsum: f64 = mine.iter().map(|h| h.weight).sum();
+    let pixel = mine.iter().map(|h| h.pixel * h.weight).sum::<DVec2>() / wsum;
+    let point = mine.iter().map(|h| h.point * h.weight).sum::<DVec3>() / wsum;
+    Some((pixel, point))
+}
+
+/// The room a body moved by the start guess keeps from its neighbours, as a share of
+/// their bounding radii summed: bodies launched side by side with a spin sweep their
+/// corners around, and touching neighbours would collide at once.
+const ROOM: f64 = 0.25;
+
 /// Whether occluder `i` moved to `position` stays on the table's top and clear of every
-/// other occluder (by a millimetre).
+/// other occluder (by [`ROOM`]).
 fn fits(occ: &[Occluder], i: usize, position: DVec3, table: &Table) -> bool {
     let o = &occ[i];
     let c = position + o.orientation * o.mass.local_com;
@@ -126,8 +192,9 @@ fn fits(occ: &[Occluder], i: usize, position: DVec3, table: &Table) -> bool {
     }
     let mine = ContactShape::new(&o.shape);
     occ.iter().enumerate().all(|(j, p)| {
+        let room = ROOM * (o.bounding_radius + p.bounding_radius);
         j == i
-            || c.distance(p.launch_com()) > o.bounding_radius + p.bounding_radius + 1e-3
+            || c.distance(p.launch_com()) > o.bounding_radius + p.bounding_radius + room
             || signed_distance(
                 &mine,
                 position,
@@ -135,7 +202,7 @@ fn fits(occ: &[Occluder], i: usize, position: DVec3, table: &Table) -> bool {
                 &ContactShape::new(&p.shape),
                 p.position,
                 p.orientation,
-            ) > 1e-3
+            ) > room
     })
 }
 
