@@ -50,7 +50,10 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         fmt_vec(s.gravity)
     );
     if s.pictures.len() > 1 {
-        println!("  pictures {} (the last is the target and t above):", s.pictures.len());
+        println!(
+            "  pictures {} (the last is the target and t above):",
+            s.pictures.len()
+        );
         for (k, p) in s.pictures.iter().enumerate() {
             println!(
                 "    {} at t = {} s: {} ({} shadow pixels), weight {:.3}, {} hints",

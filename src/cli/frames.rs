@@ -32,10 +32,14 @@ pub(super) fn write_pictures(
     if scene.pictures.len() > 1 {
         for (k, pic) in scene.pictures.iter().enumerate() {
             problem.shadow_at(pic.t, ws);
-            let img = crate::output::picture::mask_image(ws.mask.width(), ws.mask.height(), &|x, y| {
-                ws.mask.get(x, y)
-            });
-            let (shadow, overlay) = (format!("shadow_{}.png", k + 1), format!("overlay_{}.png", k + 1));
+            let img =
+                crate::output::picture::mask_image(ws.mask.width(), ws.mask.height(), &|x, y| {
+                    ws.mask.get(x, y)
+                });
+            let (shadow, overlay) = (
+                format!("shadow_{}.png", k + 1),
+                format!("overlay_{}.png", k + 1),
+            );
             files::save_png(&img, &dir.join(&shadow))?;
             let title = format!("{}: picture {} at t = {} s", scene.name, k + 1, pic.t);
             files::save_overlay(&dir.join(&overlay), &pic.target, &ws.mask, &title)?;
@@ -51,7 +55,12 @@ pub(super) fn write_pictures(
             w.t - pic.t,
             hold.window
         );
-        files::save_overlay(&dir.join("overlay_worst.png"), &pic.target, &ws.mask, &title)?;
+        files::save_overlay(
+            &dir.join("overlay_worst.png"),
+            &pic.target,
+            &ws.mask,
+            &title,
+        )?;
         written.push("overlay_worst.png".into());
     }
     Ok(written)

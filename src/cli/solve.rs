@@ -10,11 +10,11 @@ use anyhow::{bail, Context, Result};
 use crate::budget::Tolerances;
 use crate::energy::Weights;
 use crate::evaluate::{Problem, Robust};
-use crate::scene::LaunchPositions;
-use crate::sim::drag::DragConfig;
 use crate::optimize::solver::{self, SolveOptions};
 use crate::output::files;
 use crate::output::solution::{self, Solution};
+use crate::scene::LaunchPositions;
+use crate::sim::drag::DragConfig;
 
 use super::progress::SolveProgress;
 use super::{export, frames, guard, load, outdir, SolveArgs};
@@ -49,6 +49,9 @@ pub(super) struct Options {
 
 /// Perturbed launches per sample of `--robust` unless `--draws` says otherwise.
 const DEFAULT_DRAWS: usize = 16;
+/// The least perturbed launches of the reference set that a robust solve compares the
+/// samples of different iterations on (four times `--draws` if more).
+const REFERENCE_DRAWS: usize = 64;
 /// The most perturbed launches per sample `--draws` accepts.
 const MAX_DRAWS: usize = 10_000;
 
@@ -95,13 +98,17 @@ impl Options {
             Some(Robust {
                 tolerances: t,
                 draws,
+                reference_draws: (4 * draws).max(REFERENCE_DRAWS),
                 quantile: args.quantile,
             })
         } else {
-            let given = [("--draws", args.draws.is_some()), ("--quantile", args.quantile.is_some())]
-                .into_iter()
-                .chain(tolerances.iter().map(|(n, v)| (*n, v.is_some())))
-                .find(|(_, g)| *g);
+            let given = [
+                ("--draws", args.draws.is_some()),
+                ("--quantile", args.quantile.is_some()),
+            ]
+            .into_iter()
+            .chain(tolerances.iter().map(|(n, v)| (*n, v.is_some())))
+            .find(|(_, g)| *g);
             if let Some((name, _)) = given {
                 bail!("{name} is an option of --robust: add --robust");
             }

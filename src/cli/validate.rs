@@ -44,7 +44,11 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let several = scene.pictures.len() > 1;
     let mut reports = Vec::new();
     for (k, pic) in scene.pictures.iter().enumerate() {
-        let suffix = if several { format!("_{}", k + 1) } else { String::new() };
+        let suffix = if several {
+            format!("_{}", k + 1)
+        } else {
+            String::new()
+        };
         let mask_path = dir.join(format!("cycles_mask{suffix}.png"));
         let mut args = vec![
             "--glb".to_string(),

@@ -87,6 +87,10 @@ pub struct Robust {
     pub tolerances: Tolerances,
     /// Perturbed launches per sample.
     pub draws: usize,
+    /// Perturbed launches of the reference set ([`REFERENCE_DRAW`]), on which samples of
+    /// different iterations are compared: larger than `draws`, so that the best kept is
+    /// not the one that was lucky with a small set.
+    pub reference_draws: usize,
     /// `None`: the mean image energy over the draws; `Some(q)`: its `q`-quantile.
     pub quantile: Option<f64>,
 }
@@ -181,7 +185,7 @@ pub struct Scratch {
 
 impl Scratch {
     pub(super) fn new(n: usize, plan: &Plan) -> Scratch {
-        let draws = plan.robust.map_or(0, |r| r.draws);
+        let draws = plan.robust.map_or(0, |r| r.draws.max(r.reference_draws));
         Scratch {
             flights: (0..if draws > 0 { n } else { 0 })
                 .map(|_| FreeFlight::default())
@@ -227,12 +231,22 @@ impl Problem {
     /// with free positions [`POSITION_LEN`] more per occluder after them.
     pub fn variable_count(&self) -> usize {
         let n = self.scene.occluders.len();
-        Launch::LEN * n + if self.plan.free_positions { POSITION_LEN * n } else { 0 }
+        Launch::LEN * n
+            + if self.plan.free_positions {
+                POSITION_LEN * n
+            } else {
+                0
+            }
     }
 
     /// Number of values CMA-ES searches in a stage varying the occluders `vary`.
     pub fn stage_variable_count(&self, vary: &[usize]) -> usize {
-        let per = Launch::LEN + if self.plan.free_positions { POSITION_LEN } else { 0 };
+        let per = Launch::LEN
+            + if self.plan.free_positions {
+                POSITION_LEN
+            } else {
+                0
+            };
         per * vary.len()
     }
 
@@ -484,10 +498,15 @@ impl Problem {
         ws: &mut Workspace,
         raw: &mut [f64; TERM_COUNT],
     ) -> f64 {
-        let scale = 1.0 / robust.draws as f64;
+        let draws = if draw == REFERENCE_DRAW {
+            robust.reference_draws
+        } else {
+            robust.draws
+        };
+        let scale = 1.0 / draws as f64;
         let mut scratch = std::mem::take(&mut ws.multi);
         scratch.totals.clear();
-        for s in 0..robust.draws {
+        for s in 0..draws {
             draw_errors(draw, s as u64, &robust.tolerances, &mut scratch.errors);
             let mut diverged = false;
             for (i, o) in self.scene.occluders.iter().enumerate() {
@@ -582,12 +601,25 @@ impl Problem {
                     continue;
                 }
                 let (a, b) = (&scene.occluders[i], &scene.occluders[j]);
-                let (pa, pb) = (self.launch_position(params, i), self.launch_position(params, j));
-                let (ca, cb) = (pa + a.orientation * a.mass.local_com, pb + b.orientation * b.mass.local_com);
+                let (pa, pb) = (
+                    self.launch_position(params, i),
+                    self.launch_position(params, j),
+                );
+                let (ca, cb) = (
+                    pa + a.orientation * a.mass.local_com,
+                    pb + b.orientation * b.mass.local_com,
+                );
                 if ca.distance(cb) > a.bounding_radius + b.bounding_radius {
                     continue;
                 }
-                let d = signed_distance(&self.shapes[i], pa, a.orientation, &self.shapes[j], pb, b.orientation);
+                let d = signed_distance(
+                    &self.shapes[i],
+                    pa,
+                    a.orientation,
+                    &self.shapes[j],
+                    pb,
+                    b.orientation,
+                );
                 if d < -LAUNCH_OVERLAP {
                     bad += 1;
                     depth -= d;

@@ -293,8 +293,15 @@ pub fn solve(
                 // Energies of different iterations met different errors: the iteration's
                 // best is compared with the stage's best on the reference draw.
                 improved = best_on_reference(
-                    problem, &held, stage, &params, &candidates, &fitness, &mut best_eval,
-                    &mut scratch, &mut ws,
+                    problem,
+                    &held,
+                    stage,
+                    &params,
+                    &candidates,
+                    &fitness,
+                    &mut best_eval,
+                    &mut scratch,
+                    &mut ws,
                 );
             }
             if let Some(j) = improved {
@@ -428,7 +435,12 @@ fn best_on_reference(
 ) -> Option<usize> {
     let n = candidates.len() / fitness.len();
     let j = (0..fitness.len()).min_by(|&a, &b| fitness[a].total_cmp(&fitness[b]))?;
-    problem.expand(params, &stage.vary, &candidates[j * n..(j + 1) * n], scratch);
+    problem.expand(
+        params,
+        &stage.vary,
+        &candidates[j * n..(j + 1) * n],
+        scratch,
+    );
     let e = problem.evaluate_held(held, scratch, &stage.weights, ws);
     let contacts = problem.scene.contacts;
     (rank_value(&e, contacts) < rank_value(best, contacts)).then(|| {

@@ -24,10 +24,16 @@ impl Validator<'_> {
     pub(super) fn pictures<'r>(&self, raw: &'r RawScene) -> Result<Vec<PictureSpec<'r>>> {
         let Some(list) = &raw.targets else {
             let rel = raw.target.as_ref().ok_or_else(|| {
-                self.field_err("target", "is required (or give `targets`: a list of {target, t, weight})")
+                self.field_err(
+                    "target",
+                    "is required (or give `targets`: a list of {target, t, weight})",
+                )
             })?;
             let t = raw.t.ok_or_else(|| {
-                self.field_err("t", "is required (or give `targets`: a list of {target, t, weight})")
+                self.field_err(
+                    "t",
+                    "is required (or give `targets`: a list of {target, t, weight})",
+                )
             })?;
             let t = self.positive_within("t", t, MAX_T)?;
             return Ok(vec![PictureSpec {
@@ -59,13 +65,12 @@ impl Validator<'_> {
         let mut out: Vec<PictureSpec> = Vec::with_capacity(list.len());
         for (k, p) in list.iter().enumerate() {
             let f = |s: &str| format!("targets[{k}].{s}");
-            let rel = p
-                .target
-                .as_ref()
-                .ok_or_else(|| self.field_err(f("target"), "is required: the picture's PNG file"))?;
-            let t = p
-                .t
-                .ok_or_else(|| self.field_err(f("t"), "is required: the instant of the picture (s)"))?;
+            let rel = p.target.as_ref().ok_or_else(|| {
+                self.field_err(f("target"), "is required: the picture's PNG file")
+            })?;
+            let t = p.t.ok_or_else(|| {
+                self.field_err(f("t"), "is required: the instant of the picture (s)")
+            })?;
             let t = self.positive_within(&f("t"), t, MAX_T)?;
             if let Some(prev) = out.last() {
                 if t <= prev.t {
@@ -141,7 +146,11 @@ impl Validator<'_> {
     }
 
     /// A hold objective: `"mean"` or `"worst"`.
-    pub(super) fn objective(&self, field: &str, raw: Option<&str>) -> Result<Option<HoldObjective>> {
+    pub(super) fn objective(
+        &self,
+        field: &str,
+        raw: Option<&str>,
+    ) -> Result<Option<HoldObjective>> {
         match raw {
             None => Ok(None),
             Some("mean") => Ok(Some(HoldObjective::Mean)),
@@ -211,7 +220,9 @@ impl Validator<'_> {
         if frames > MAX_INSTANTS {
             return Err(self.field_err(
                 "hold.fps",
-                format!("gives {frames} frames in the window, more than the {MAX_INSTANTS} allowed"),
+                format!(
+                    "gives {frames} frames in the window, more than the {MAX_INSTANTS} allowed"
+                ),
             ));
         }
         Ok(hold)

@@ -179,16 +179,23 @@ impl Validator<'_> {
             // The earliest picture an occluder has hints in aims it (later ones first,
             // so that earlier ones overwrite them).
             "hints" => {
+                let free_on = table
+                    .as_ref()
+                    .filter(|_| positions == LaunchPositions::Free);
+                let explicit = raw_start_overrides(&raw);
+                let aim = |t| Aim {
+                    camera: &camera,
+                    receiver: &receiver,
+                    t,
+                    gravity,
+                    rise,
+                    free_on,
+                };
                 for p in pictures.iter().rev() {
-                    Aim {
-                        camera: &camera,
-                        receiver: &receiver,
-                        t: p.t,
-                        gravity,
-                        rise,
-                        free_on: table.as_ref().filter(|_| positions == LaunchPositions::Free),
-                    }
-                    .apply(&mut occluders, &p.hints, &raw_start_overrides(&raw))
+                    aim(p.t).apply(&mut occluders, &p.hints, &explicit);
+                }
+                if let [a, b, ..] = &pictures[..] {
+                    aim(a.t).apply_between(b.t, &b.hints, &mut occluders, &a.hints, &explicit);
                 }
             }
             "up" => {}

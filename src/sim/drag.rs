@@ -339,7 +339,8 @@ impl DragTrack {
         };
         let n = self.nodes.len() - 1;
         let s = t * self.inv_h;
-        let step = |(x, v): (DVec3, DVec3), h: f64| rk4_step(body, x, v, self.g, self.k, self.lift, h);
+        let step =
+            |(x, v): (DVec3, DVec3), h: f64| rk4_step(body, x, v, self.g, self.k, self.lift, h);
         if (0.0..=n as f64).contains(&s) {
             let k = (s as usize).min(n);
             let tau = t - k as f64 * self.h;
@@ -633,6 +634,35 @@ mod tests {
             assert!(err < 1e-4, "{err}"); // 0.1 mm
             assert!(err < 1e-7, "{err}"); // what it really achieves
         }
+    }
+
+    #[test]
+    fn a_drag_track_is_fly_at_its_end_and_close_to_it_between() {
+        let g = DVec3::new(0.0, 0.0, -9.81);
+        let b = BodyDrag::new(
+            &Shape::Sphere { radius: 0.033 },
+            0.057,
+            &DragConfig::default(),
+        );
+        let (x0, v0) = (DVec3::new(0.1, -1.0, 0.5), DVec3::new(1.0, 2.0, 7.0));
+        let mut track = DragTrack::default();
+        track.reset(&b, x0, v0, DVec3::ZERO, g, 1.2, DEFAULT_MAX_STEP);
+        let bits =
+            |(x, v): (DVec3, DVec3)| [x.to_array(), v.to_array()].map(|a| a.map(f64::to_bits));
+        let end = fly(&b, x0, v0, DVec3::ZERO, g, 1.2, DEFAULT_MAX_STEP);
+        assert_eq!(bits(track.state(1.2)), bits(end));
+        let mut worst: f64 = 0.0;
+        for k in 0..=37 {
+            let t = 1.3 * k as f64 / 37.0; // past the grid too
+            let (x, _) = track.state(t);
+            let (y, _) = fly(&b, x0, v0, DVec3::ZERO, g, t, 1e-4);
+            worst = worst.max(x.distance(y));
+        }
+        assert!(worst < 1e-7, "{worst}");
+        // The bound holds over the flight (the drag at the launch speed is the largest).
+        let k = b.k();
+        assert!(track.accel_bound() >= k * v0.length_squared());
+        assert!(track.accel_bound() < 2.0 * k * v0.length_squared());
     }
 
     #[test]

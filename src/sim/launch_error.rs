@@ -131,4 +131,3 @@ pub fn draw_errors(seed: u64, k: u64, tol: &Tolerances, out: &mut [BodyError]) {
         };
     }
 }
-
