@@ -319,6 +319,15 @@ pub fn run(
         "Tolerances are 1-sigma normal errors, independent per body; direction: each of two perpendicular components.".to_string(),
         "The Monte Carlo flies the compensated launch through air; contacts are not modelled with drag.".to_string(),
     ];
+    if let crate::evaluate::Physics::Air { .. } = problem.plan.physics {
+        notes.push("The launch was solved with air in the loop (`bsa solve --air`): the \"vacuum\" figures are the solve's own model, with drag, and the compensated launch is the launch itself.".to_string());
+    }
+    if !scene.single_instant() {
+        notes.push(format!(
+            "The scene has several instants (pictures or a hold window): the budget measures the picture at t = {} s only.",
+            scene.t
+        ));
+    }
     for (o, l) in scene.occluders.iter().zip(&b.landed) {
         if let Some(tl) = l {
             notes.push(format!(
