@@ -42,6 +42,22 @@ fn solve(scene: &Path, out: &Path, extra: &[&str]) -> String {
     stdout
 }
 
+/// `bsa render` of `launch` in `scene` into `out`, with extra arguments; its stdout.
+fn render(scene: &Path, launch: &Path, out: &Path, extra: &[&str]) -> String {
+    let mut a = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "--solution",
+        launch.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    a.extend_from_slice(extra);
+    let (ok, text, err) = bsa(&a);
+    assert!(ok, "{err}");
+    text
+}
+
 /// solution.json without what differs from run to run (timings, threads, the path).
 fn untimed(path: &Path) -> serde_json::Value {
     let mut s = read_json(path);
@@ -245,17 +261,8 @@ fn hold_reports_every_frame_and_draws_the_worst() {
         .collect();
     assert_eq!(e_ious, ious);
     let r = d.join("render");
-    let (ok, text, err) = bsa(&[
-        "render",
-        d.to_str().unwrap(),
-        "--solution",
-        sol.to_str().unwrap(),
-        "--out",
-        r.to_str().unwrap(),
-        "--at",
-        &t[6].to_string(),
-    ]);
-    assert!(ok && text.contains("worst IoU"), "{err}{text}");
+    let text = render(&d, &sol, &r, &["--at", &t[6].to_string()]);
+    assert!(text.contains("worst IoU"), "{text}");
     assert!(r.join("overlay_worst.png").is_file());
     // The render at the window's last frame gives that frame's IoU.
     assert!(
@@ -302,15 +309,7 @@ fn sequence_solves_exports_and_renders_both_pictures() {
     assert_eq!(poses.len(), 5);
     // render and eval read the solution (its positions) back: the same IoUs.
     let scene = out.parent().unwrap();
-    let (ok, text, err) = bsa(&[
-        "render",
-        scene.to_str().unwrap(),
-        "--solution",
-        out.join("solution.json").to_str().unwrap(),
-        "--out",
-        out.join("render").to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
+    let text = render(scene, &out.join("solution.json"), &out.join("render"), &[]);
     for (k, f) in frames.iter().enumerate() {
         let line = format!(
             "picture {} at t = {} s: IoU {:.4}",
@@ -321,15 +320,7 @@ fn sequence_solves_exports_and_renders_both_pictures() {
         assert!(text.contains(&line), "{line} not in\n{text}");
     }
     // The launch table moves the blocks too (to the micrometre).
-    let (ok, text, err) = bsa(&[
-        "render",
-        scene.to_str().unwrap(),
-        "--solution",
-        out.join("launch.csv").to_str().unwrap(),
-        "--out",
-        out.join("render-csv").to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
+    let text = render(scene, &out.join("launch.csv"), &out.join("render-csv"), &[]);
     let iou_at = |text: &str| -> f64 {
         text.split("IoU at 1 s ").nth(1).unwrap()[..6]
             .parse()
@@ -364,19 +355,7 @@ fn air_solve_records_its_air_and_every_command_flies_through_it() {
     // The launch table is the air one: in a vacuum it misses, with --air it does not.
     let csv = out.join("launch.csv");
     let iou = |extra: &[&str]| -> f64 {
-        let mut a = vec![
-            "render",
-            d.to_str().unwrap(),
-            "--solution",
-            csv.to_str().unwrap(),
-            "--out",
-        ];
-        let r = d.join(format!("render{}", extra.len()));
-        let r = r.to_str().unwrap().to_string();
-        a.push(&r);
-        a.extend_from_slice(extra);
-        let (ok, text, err) = bsa(&a);
-        assert!(ok, "{err}");
+        let text = render(&d, &csv, &d.join(format!("render{}", extra.len())), extra);
         text.split("IoU at 1.2 s ").nth(1).unwrap()[..6]
             .parse()
             .unwrap()
