@@ -59,9 +59,13 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let scene = &problem.scene;
     let at = opts.at.unwrap_or(scene.t);
     if at > scene.horizon() {
+        let window = match &scene.hold {
+            Some(_) => format!(" and the end of its hold window, {} s", scene.horizon()),
+            None => String::new(),
+        };
         bail!(
-            "--at {at} s is after {} s: the solver's model stops at t (or at the end of its hold window; the motion after it is rapier's; see `bsa export` and the glb)",
-            scene.horizon()
+            "--at {at} s is after t = {} s{window}: the solver's model stops there (the motion after it is rapier's; see `bsa export` and the glb)",
+            scene.t
         );
     }
     let mut ws = problem.workspace();
@@ -97,6 +101,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         f
     };
     let contact = match e.outcome.first_contact {
+        None if scene.hold.is_some() => format!("no contact before {} s", scene.horizon()),
         None => "no contact before t".to_string(),
         Some((i, j)) => format!(
             "first contact at {:.4} s: `{}` with `{}`",

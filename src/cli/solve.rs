@@ -325,7 +325,7 @@ fn solve_into(
     let report = crate::output::report::write_report(&out, &solution)?;
     clock.lap("report page");
     println!(
-        "{}: {} {:.4}, {} before t ({} contacts), {} samples in {} iterations, {:.2} s on {} threads{}",
+        "{}: {} {:.4}, {} before {} ({} contacts), {} samples in {} iterations, {:.2} s on {} threads{}",
         scene.name,
         if scene.single_instant() {
             "IoU at t"
@@ -337,6 +337,10 @@ fn solve_into(
             "no contact".to_string()
         } else {
             format!("first contact at {:.4} s", solution.t_sim)
+        },
+        match scene.hold {
+            Some(_) => format!("{} s (the end of the hold window)", scene.horizon()),
+            None => "t".to_string(),
         },
         solution.n_contacts,
         solution.samples,
