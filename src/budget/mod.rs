@@ -36,9 +36,6 @@ pub mod plots;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{DMat3, DQuat, DVec3};
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -49,6 +46,9 @@ use crate::output::solution::{check_solution, MismatchError, Solution};
 use crate::scene::Launch;
 use crate::sim::drag::{self, BodyDrag, DragConfig, DragError};
 use crate::sim::flight::{FreeFlight, LaunchState};
+pub use crate::sim::launch_error::{
+    aim, draw_errors, sample_seed, BodyError, Tolerances, PARAMETERS,
+};
 
 mod montecarlo;
 mod report;
@@ -74,65 +74,7 @@ const MAX_NEWTON: usize = 40;
 /// Centre-of-mass residual at which the compensation stops (m).
 const NEWTON_TOL: f64 = 1e-9;
 
-/// Launch errors, each the standard deviation of a normal error (1 sigma), independent
-/// per body.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct Tolerances {
-    /// Launch speed (% of the speed). Default 0.5 %.
-    pub speed_pct: f64,
-    /// Launch direction (deg), each of two perpendicular components. Default 0.25 deg.
-    pub direction_deg: f64,
-    /// Spin rate (% of the angular speed; the axis is kept). Default 2 %.
-    pub spin_pct: f64,
-    /// Release time (ms): a body released `dt` late has at `t` its pose at `t - dt`.
-    /// Default 1 ms.
-    pub timing_ms: f64,
-    /// Drag coefficient (% of Cd): the model error. Default 5 %.
-    pub cd_pct: f64,
-}
-
-impl Default for Tolerances {
-    fn default() -> Self {
-        Tolerances {
-            speed_pct: 0.5,
-            direction_deg: 0.25,
-            spin_pct: 2.0,
-            timing_ms: 1.0,
-            cd_pct: 5.0,
-        }
-    }
-}
-
-/// The five error kinds: key, unit, largest accepted tolerance.
-pub const PARAMETERS: [(&str, &str, f64); 5] = [
-    ("speed", "%", 50.0),
-    ("direction", "deg", 45.0),
-    ("spin", "%", 100.0),
-    ("timing", "ms", 100.0),
-    ("cd", "%", 50.0),
-];
-
 impl Tolerances {
-    pub fn to_array(&self) -> [f64; 5] {
-        [
-            self.speed_pct,
-            self.direction_deg,
-            self.spin_pct,
-            self.timing_ms,
-            self.cd_pct,
-        ]
-    }
-
-    pub fn from_array(a: [f64; 5]) -> Tolerances {
-        Tolerances {
-            speed_pct: a[0],
-            direction_deg: a[1],
-            spin_pct: a[2],
-            timing_ms: a[3],
-            cd_pct: a[4],
-        }
-    }
-
     /// Every tolerance finite and within `[0, limit]` ([`PARAMETERS`]); the timing also
     /// below a third of `t`.
     pub fn validate(&self, t: f64) -> Result<(), BudgetError> {
@@ -377,6 +319,15 @@ pub fn run(
         "Tolerances are 1-sigma normal errors, independent per body; direction: each of two perpendicular components.".to_string(),
         "The Monte Carlo flies the compensated launch through air; contacts are not modelled with drag.".to_string(),
     ];
+    if let crate::evaluate::Physics::Air { .. } = problem.plan.physics {
+        notes.push("The launch was solved with air in the loop (`bsa solve --air`): the \"vacuum\" figures are the solve's own model, with drag, and the compensated launch is the launch itself.".to_string());
+    }
+    if !scene.single_instant() {
+        notes.push(format!(
+            "The scene has several instants (pictures or a hold window): the budget measures the picture at t = {} s only.",
+            scene.t
+        ));
+    }
     for (o, l) in scene.occluders.iter().zip(&b.landed) {
         if let Some(tl) = l {
             notes.push(format!(

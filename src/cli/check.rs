@@ -49,6 +49,36 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         s.dt,
         fmt_vec(s.gravity)
     );
+    if s.pictures.len() > 1 {
+        println!(
+            "  pictures {} (the last is the target and t above):",
+            s.pictures.len()
+        );
+        for (k, p) in s.pictures.iter().enumerate() {
+            println!(
+                "    {} at t = {} s: {} ({} shadow pixels), weight {:.3}, {} hints",
+                k + 1,
+                p.t,
+                p.file.display(),
+                p.target.count(),
+                p.weight,
+                p.hints.len()
+            );
+        }
+    }
+    if let Some(h) = &s.hold {
+        let evaluated = h.offsets().len();
+        println!(
+            "  hold     +-{} s around each picture: {} frames at {} fps reported, {} instants evaluated per picture",
+            h.window,
+            h.frame_offsets().len(),
+            h.fps,
+            evaluated
+        );
+    }
+    if s.positions == crate::scene::LaunchPositions::Free {
+        println!("  positions free: launch positions on the table are optimised too");
+    }
     println!("  light    {} m", fmt_vec(s.light));
     let r = &s.receiver;
     println!(
@@ -123,7 +153,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     // contact in it, since a start that collides is a slow start.
     let problem = Problem::new(s.clone());
     let mut ws = problem.workspace();
-    let e = problem.evaluate(&s.start_parameters(), &Weights::all_ones(), &mut ws);
+    let e = problem.evaluate(&problem.start_parameters(), &Weights::all_ones(), &mut ws);
     match e.outcome.first_contact {
         Some((i, j)) => println!(
             "  start    IoU at t {:.4}; first contact at {:.4} s: `{}` with `{}`",
@@ -133,6 +163,10 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             j.map_or("table", |j| s.occluders[j].name.as_str())
         ),
         None => println!("  start    IoU at t {:.4}; no contact before t", e.iou),
+    }
+    if !s.single_instant() {
+        let f = problem.frame_ious(&problem.start_parameters(), &mut ws);
+        super::frames::print(&problem, &f);
     }
     println!("ok");
     Ok(())

@@ -7,7 +7,6 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 
 use crate::energy::{Term, Weights};
-use crate::evaluate::Problem;
 use crate::output::files;
 use crate::scene::Scene;
 
@@ -54,9 +53,9 @@ impl Options {
 pub(super) fn run(opts: &Options) -> Result<()> {
     let scene = load::scene(&opts.scene)?;
     let k = opts.stage(&scene)?;
-    let problem = Problem::new(scene);
     let solution_path = &opts.solution;
     let s = files::read_solution(solution_path)?;
+    let problem = load::problem_for(scene, &s);
     // As budget does: the names, counts and t, and the same shadow when re-evaluated, so
     // that a solution of an edited scene is refused instead of reported as if current.
     crate::budget::check_solution_current(&problem, &s)
@@ -83,6 +82,11 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         .filter(|(inside, _)| !**inside)
         .map(|(_, o)| o.name.as_str())
         .collect();
+    let frame_ious = if scene.single_instant() {
+        Vec::new()
+    } else {
+        problem.frame_ious(&s.parameters(), &mut ws)
+    };
     let timings = match opts.profile {
         Some(reps) => problem.profile(&s.parameters(), reps.max(1), &mut ws),
         None => Vec::new(),
@@ -109,6 +113,13 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             "shadows_outside_image": outside,
             "time_per_phase_us": timings.iter().map(|(k, v)| (k.clone(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
         });
+        let mut v = v;
+        if !frame_ious.is_empty() {
+            v["frames"] = frame_ious
+                .iter()
+                .map(|f| serde_json::json!({"t_s": f.t, "picture": f.picture + 1, "iou": f.iou}))
+                .collect();
+        }
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         println!(
@@ -138,6 +149,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         if let Some((a, b)) = &first_contact {
             println!("first contact: `{a}` with `{b}`");
         }
+        super::frames::print(&problem, &frame_ious);
         if outside.is_empty() {
             println!(
                 "every occluder's shadow lies in the image ({} occluders)",

@@ -17,6 +17,18 @@ pub(super) fn scene(path: &Path) -> Result<Scene> {
     Ok(scene::load(path)?)
 }
 
+/// The problem a saved solution is evaluated in: its scene with the bodies at the
+/// solution's launch positions (a solve with free positions moved them), flown through
+/// the solution's air (`bsa solve --air`).
+pub(super) fn problem_for(mut scene: Scene, solution: &Solution) -> Problem {
+    solution.place(&mut scene);
+    let mut problem = Problem::new(scene);
+    if let Some(air) = solution.air {
+        problem.set_air(air);
+    }
+    problem
+}
+
 /// Load `DIR/solution.json` and its scene, and check that they belong together: the
 /// names, counts and `t`, and the same shadow when re-evaluated (as budget checks), so
 /// that export, validate and video refuse a solution of an edited scene.
@@ -58,7 +70,7 @@ pub(super) fn solution_and_scene(
             .filter(|p| p.exists())
             .unwrap_or_else(|| PathBuf::from("scenes").join(&solution.scene)),
     };
-    let problem = Problem::new(self::scene(&scene_path)?);
+    let problem = problem_for(self::scene(&scene_path)?, &solution);
     Ok((problem, solution, scene_path))
 }
 

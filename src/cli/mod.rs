@@ -22,6 +22,7 @@ mod budget;
 mod check;
 mod eval;
 mod export;
+mod frames;
 pub mod guard;
 mod load;
 mod new;
@@ -122,6 +123,41 @@ struct SolveArgs {
     /// No progress bars.
     #[arg(long, short)]
     quiet: bool,
+    /// Fly every body through air while solving (quadratic drag with the budget's default
+    /// model), so that the launch table is the one to use in air.
+    #[arg(long)]
+    air: bool,
+    /// Optimise the image energy expected under launch errors (the budget's error model,
+    /// with the tolerances below), with the same errors for every sample of an iteration.
+    #[arg(long)]
+    robust: bool,
+    /// Perturbed launches per sample with --robust [default: 16].
+    #[arg(long, value_name = "N")]
+    draws: Option<usize>,
+    /// With --robust, optimise this quantile of the image energy over the perturbed
+    /// launches instead of its mean, in (0, 1) (e.g. 0.9: the best 90 %).
+    #[arg(long, value_name = "Q", allow_negative_numbers = true)]
+    quantile: Option<f64>,
+    /// With --robust: launch speed error, 1 sigma (% of the speed) [default: 0.5].
+    #[arg(long, allow_negative_numbers = true)]
+    speed_tol: Option<f64>,
+    /// With --robust: launch direction error, 1 sigma per perpendicular component (deg)
+    /// [default: 0.25].
+    #[arg(long, allow_negative_numbers = true)]
+    direction_tol: Option<f64>,
+    /// With --robust: spin rate error, 1 sigma (% of the angular speed) [default: 2].
+    #[arg(long, allow_negative_numbers = true)]
+    spin_tol: Option<f64>,
+    /// With --robust: release timing error, 1 sigma (ms) [default: 1].
+    #[arg(long, allow_negative_numbers = true)]
+    timing_tol: Option<f64>,
+    /// With --robust --air: drag coefficient error, 1 sigma (% of Cd) [default: 5].
+    #[arg(long, allow_negative_numbers = true)]
+    cd_tol: Option<f64>,
+    /// Optimise the launch positions too (x and y on the table; bounded to the table's
+    /// top, contact-free at launch), as the scene's `"positions": "free"` does.
+    #[arg(long)]
+    free_positions: bool,
 }
 
 // Raw arguments of `bsa export`.
@@ -307,9 +343,14 @@ struct RenderArgs {
     /// Output folder [default: render/ beside the launch file].
     #[arg(long)]
     out: Option<PathBuf>,
-    /// The instant of the shadow (s, after the launch, at most t) [default: t].
+    /// The instant of the shadow (s, after the launch, at most t, or the end of the hold
+    /// window) [default: t].
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     at: Option<f64>,
+    /// Fly through air with the default drag model (a launch table of `bsa solve --air`;
+    /// a solution.json says so itself).
+    #[arg(long)]
+    air: bool,
 }
 
 // Raw arguments of `bsa new`.

@@ -1,6 +1,8 @@
 //! `bsa render`: the shadow of any launch at `t` or another instant before it, from a
 //! solve's `solution.json`, the builders' `launch.csv` or a minimal launch file
-//! ([`crate::output::launches`]): `shadow.png`, `overlay.png` and the IoU.
+//! ([`crate::output::launches`]): `shadow.png`, `overlay.png` and the IoU; for a scene
+//! with several pictures or a hold window also the IoU at every frame, an overlay per
+//! picture and the worst frame's ([`super::frames`]).
 
 use std::path::PathBuf;
 
@@ -9,8 +11,9 @@ use anyhow::{bail, Context, Result};
 use crate::energy::{self, Weights};
 use crate::evaluate::Problem;
 use crate::output::{files, launches};
+use crate::sim::drag::DragConfig;
 
-use super::{load, RenderArgs};
+use super::{frames, load, RenderArgs};
 
 /// The validated options of `bsa render`.
 pub(super) struct Options {
@@ -19,6 +22,8 @@ pub(super) struct Options {
     out: PathBuf,
     /// Finite and positive when given; checked against `t` once the scene is loaded.
     at: Option<f64>,
+    /// Fly through air (a launch table of `bsa solve --air`).
+    air: bool,
 }
 
 impl Options {
@@ -38,32 +43,45 @@ impl Options {
             solution: args.solution,
             out,
             at: args.at,
+            air: args.air,
         })
     }
 }
 
 pub(super) fn run(opts: &Options) -> Result<()> {
-    let problem = Problem::new(load::scene(&opts.scene)?);
+    let mut scene = load::scene(&opts.scene)?;
+    let launch = launches::read_launches(&opts.solution, &mut scene)?;
+    let params = launch.params;
+    let mut problem = Problem::new(scene);
+    if let Some(air) = launch.air.or(opts.air.then(DragConfig::default)) {
+        problem.set_air(air);
+    }
     let scene = &problem.scene;
     let at = opts.at.unwrap_or(scene.t);
-    if at > scene.t {
+    if at > scene.horizon() {
+        let window = match &scene.hold {
+            Some(_) => format!(" and the end of its hold window, {} s", scene.horizon()),
+            None => String::new(),
+        };
         bail!(
-            "--at {at} s is after t = {} s: the solver's model stops at t (the motion after it is rapier's; see `bsa export` and the glb)",
+            "--at {at} s is after t = {} s{window}: the solver's model stops there (the motion after it is rapier's; see `bsa export` and the glb)",
             scene.t
         );
     }
-    let params = launches::read_launches(&opts.solution, scene)?;
     let mut ws = problem.workspace();
     // The same evaluation as a solve's final one, so that at `t` the pictures are the
     // solve's, bit for bit.
     let e = problem.evaluate(&params, &Weights::all_ones(), &mut ws);
-    let mut iou = e.iou;
-    if at < scene.t {
-        for i in 0..scene.occluders.len() {
-            ws.poses[i] = problem.state_at(&ws, i, at).0;
-        }
-        problem.shadow(&mut ws);
-        iou = energy::iou(&ws.mask, &problem.target.mask);
+    let mut iou = energy::iou(&ws.mask, &problem.target.mask);
+    // The picture an instant is scored against: the one whose instant is nearest.
+    let picture = scene
+        .pictures
+        .iter()
+        .min_by(|a, b| (a.t - at).abs().total_cmp(&(b.t - at).abs()))
+        .expect("a scene has a picture");
+    if at != scene.t {
+        problem.shadow_at(at, &mut ws);
+        iou = energy::iou(&ws.mask, &picture.target);
     }
     std::fs::create_dir_all(&opts.out)
         .with_context(|| format!("cannot create {}", opts.out.display()))?;
@@ -73,8 +91,17 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         at,
         opts.solution.display()
     );
-    files::write_pictures(&opts.out, &scene.target, &ws.mask, &title)?;
+    files::write_pictures(&opts.out, &picture.target, &ws.mask, &title)?;
+    let mut more = Vec::new();
+    let frame_ious = if scene.single_instant() {
+        Vec::new()
+    } else {
+        let f = problem.frame_ious(&params, &mut ws);
+        more = frames::write_pictures(&opts.out, &problem, &f, &mut ws)?;
+        f
+    };
     let contact = match e.outcome.first_contact {
+        None if scene.hold.is_some() => format!("no contact before {} s", scene.horizon()),
         None => "no contact before t".to_string(),
         Some((i, j)) => format!(
             "first contact at {:.4} s: `{}` with `{}`",
@@ -83,13 +110,16 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             j.map_or("the table", |j| scene.occluders[j].name.as_str())
         ),
     };
+    more.splice(0..0, ["shadow.png".to_string(), "overlay.png".to_string()]);
     println!(
-        "{}: IoU at {} s {:.4} ({}); wrote {}/{{shadow.png, overlay.png}}",
+        "{}: IoU at {} s {:.4} ({}); wrote {}/{{{}}}",
         scene.name,
         at,
         iou,
         contact,
-        opts.out.display()
+        opts.out.display(),
+        more.join(", ")
     );
+    frames::print(&problem, &frame_ious);
     Ok(())
 }

@@ -7,14 +7,17 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use anyhow::{bail, Context, Result};
 
+use crate::budget::Tolerances;
 use crate::energy::Weights;
-use crate::evaluate::Problem;
+use crate::evaluate::{Problem, Robust};
 use crate::optimize::solver::{self, SolveOptions};
 use crate::output::files;
 use crate::output::solution::{self, Solution};
+use crate::scene::LaunchPositions;
+use crate::sim::drag::DragConfig;
 
 use super::progress::SolveProgress;
-use super::{export, guard, load, outdir, SolveArgs};
+use super::{export, frames, guard, load, outdir, SolveArgs};
 
 /// Ctrl-C presses so far. The solver reads it between iterations: one press ends the
 /// current stage, a second one stops and saves the best so far.
@@ -36,7 +39,21 @@ pub(super) struct Options {
     force: bool,
     report: bool,
     quiet: bool,
+    /// Air in the loop.
+    air: bool,
+    /// Launch errors to optimise under (`--robust`), tolerances checked against `t` once
+    /// the scene is loaded.
+    robust: Option<Robust>,
+    free_positions: bool,
 }
+
+/// Perturbed launches per sample of `--robust` unless `--draws` says otherwise.
+const DEFAULT_DRAWS: usize = 16;
+/// The least perturbed launches of the reference set that a robust solve compares the
+/// samples of different iterations on (four times `--draws` if more).
+const REFERENCE_DRAWS: usize = 64;
+/// The most perturbed launches per sample `--draws` accepts.
+const MAX_DRAWS: usize = 10_000;
 
 impl Options {
     /// Check the arguments that do not depend on the scene.
@@ -46,6 +63,57 @@ impl Options {
                 bail!("--threads must be between 1 and {MAX_THREADS}, got {n}");
             }
         }
+        let tolerances = [
+            ("--speed-tol", args.speed_tol),
+            ("--direction-tol", args.direction_tol),
+            ("--spin-tol", args.spin_tol),
+            ("--timing-tol", args.timing_tol),
+            ("--cd-tol", args.cd_tol),
+        ];
+        let robust = if args.robust {
+            let draws = args.draws.unwrap_or(DEFAULT_DRAWS);
+            if !(1..=MAX_DRAWS).contains(&draws) {
+                bail!("--draws must be between 1 and {MAX_DRAWS}, got {draws}");
+            }
+            if let Some(q) = args.quantile {
+                if !(q > 0.0 && q < 1.0) {
+                    bail!("--quantile must be between 0 and 1 (exclusive), got {q}");
+                }
+            }
+            if args.cd_tol.is_some() && !args.air {
+                bail!("--cd-tol is the error of the drag model: it needs --air");
+            }
+            let d = Tolerances::default();
+            let mut t = Tolerances {
+                speed_pct: args.speed_tol.unwrap_or(d.speed_pct),
+                direction_deg: args.direction_tol.unwrap_or(d.direction_deg),
+                spin_pct: args.spin_tol.unwrap_or(d.spin_pct),
+                timing_ms: args.timing_tol.unwrap_or(d.timing_ms),
+                cd_pct: args.cd_tol.unwrap_or(d.cd_pct),
+            };
+            // In a vacuum there is no drag coefficient to be wrong.
+            if !args.air {
+                t.cd_pct = 0.0;
+            }
+            Some(Robust {
+                tolerances: t,
+                draws,
+                reference_draws: (4 * draws).max(REFERENCE_DRAWS),
+                quantile: args.quantile,
+            })
+        } else {
+            let given = [
+                ("--draws", args.draws.is_some()),
+                ("--quantile", args.quantile.is_some()),
+            ]
+            .into_iter()
+            .chain(tolerances.iter().map(|(n, v)| (*n, v.is_some())))
+            .find(|(_, g)| *g);
+            if let Some((name, _)) = given {
+                bail!("{name} is an option of --robust: add --robust");
+            }
+            None
+        };
         Ok(Options {
             scene: args.scene,
             out: args.out,
@@ -55,6 +123,9 @@ impl Options {
             force: args.force,
             report: args.report,
             quiet: args.quiet,
+            air: args.air,
+            robust,
+            free_positions: args.free_positions,
         })
     }
 }
@@ -77,7 +148,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             );
         }
     }
-    let problem = Problem::new(scene);
+    let problem = problem(opts, scene)?;
     clock.lap("scene loading and set-up");
     let scene = &problem.scene;
     let needed = guard::estimated_bytes(
@@ -111,6 +182,32 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             Err(e)
         }
     }
+}
+
+/// The problem the options ask to solve: free positions, air and launch errors.
+fn problem(opts: &Options, mut scene: crate::scene::Scene) -> Result<Problem> {
+    if opts.free_positions {
+        if scene.table.is_none() {
+            bail!(
+                "--free-positions: the scene {} has no table to bound the launch positions to",
+                scene.source.display()
+            );
+        }
+        scene.positions = LaunchPositions::Free;
+    }
+    if let Some(r) = &opts.robust {
+        r.tolerances
+            .validate(scene.t)
+            .context("the tolerances of --robust")?;
+    }
+    let mut problem = Problem::new(scene);
+    if opts.air {
+        problem.set_air(DragConfig::default());
+    }
+    if let Some(r) = opts.robust {
+        problem.set_robust(r);
+    }
+    Ok(problem)
 }
 
 /// The solve itself, into a locked output folder; returns the solution it saved.
@@ -197,12 +294,26 @@ fn solve_into(
     if keep_previous && solution.stages_completed < solution.stages_total {
         return Ok(solution);
     }
+    // The pictures and exports launch from where the solution does (free positions).
+    let placed;
+    let problem = if problem.plan.free_positions {
+        placed = load::problem_for(scene.clone(), &solution);
+        &placed
+    } else {
+        problem
+    };
     let mut ws = problem.workspace();
     let params = solution.parameters();
     problem.evaluate(&params, &Weights::all_ones(), &mut ws);
     let title = format!("{}: shadow at t = {} s", scene.name, scene.t);
     files::write_pictures(&out, &scene.target, &ws.mask, &title)?;
     files::write_preview(&out, &scene.target, &ws.mask)?;
+    let frame_ious = if scene.single_instant() {
+        Vec::new()
+    } else {
+        problem.frame_ious(&params, &mut ws)
+    };
+    let more = frames::write_pictures(&out, problem, &frame_ious, &mut ws)?;
     clock.lap("shadow, overlay and preview");
     let (exported, _) = export::write_exports(
         &out,
@@ -214,13 +325,22 @@ fn solve_into(
     let report = crate::output::report::write_report(&out, &solution)?;
     clock.lap("report page");
     println!(
-        "{}: IoU at t {:.4}, {} before t ({} contacts), {} samples in {} iterations, {:.2} s on {} threads{}",
+        "{}: {} {:.4}, {} before {} ({} contacts), {} samples in {} iterations, {:.2} s on {} threads{}",
         scene.name,
+        if scene.single_instant() {
+            "IoU at t"
+        } else {
+            "worst IoU of the instants"
+        },
         solution.iou,
         if solution.n_contacts == 0 {
             "no contact".to_string()
         } else {
             format!("first contact at {:.4} s", solution.t_sim)
+        },
+        match scene.hold {
+            Some(_) => format!("{} s (the end of the hold window)", scene.horizon()),
+            None => "t".to_string(),
         },
         solution.n_contacts,
         solution.samples,
@@ -230,9 +350,11 @@ fn solve_into(
         if solution.complete { "" } else { " (stopped early)" }
     );
     println!(
-        "wrote {}/{{solution.json, convergence.csv, convergence.png, convergence.svg, shadow.png, overlay.png, preview.png}}",
-        out.display()
+        "wrote {}/{{solution.json, convergence.csv, convergence.png, convergence.svg, shadow.png, overlay.png, preview.png{}}}",
+        out.display(),
+        more.iter().map(|m| format!(", {m}")).collect::<String>()
     );
+    frames::print(problem, &frame_ious);
     println!("{exported}");
     println!("report: {}", report.display());
     if opts.report {

@@ -20,6 +20,9 @@
 //!
 //! The numeric core does not fail: non-finite launch values or a diverged flight give
 //! [`DIVERGED_ENERGY`], never an error.
+//!
+//! A scene with several pictures, a hold window, air in the loop, launch errors or free
+//! launch positions scores several shadows per sample: see [`instants`].
 
 use glam::{DQuat, DVec3};
 
@@ -30,7 +33,10 @@ use crate::scene::{Launch, Scene};
 use crate::shadow::mask::Mask;
 use crate::shadow::raster::{ClosedMesh, MeshSilhouette, RasterScratch};
 use crate::sim::contact::{self, Body, Motion};
-use crate::sim::flight::{FlightConfig, FreeFlight, LaunchState};
+use crate::sim::flight::{FlightConfig, FreeFlight};
+
+pub mod instants;
+pub use instants::{FrameIou, Instant, Physics, Plan, Robust, REFERENCE_DRAW};
 
 /// Largest total rotation (rad) of a launched body by `t` that a sample may ask for; more
 /// (over 300 turns) is treated as a diverged sample.
@@ -57,7 +63,12 @@ const SIMULTANEOUS: f64 = 1e-6;
 /// A scene plus everything the hot loop derives from it once.
 pub struct Problem {
     pub scene: Scene,
+    /// The target of the scene's `t` (the last picture).
     pub target: TargetData,
+    /// Every picture's target, as `scene.pictures`.
+    pub pictures: Vec<TargetData>,
+    /// What a sample is scored on: instants, physics, launch errors.
+    pub plan: Plan,
     pub shapes: Vec<ContactShape>,
     table_shape: Option<ContactShape>,
     /// Whether each mesh is closed and outward-oriented (enables back-face culling).
@@ -84,6 +95,8 @@ pub struct Workspace {
     /// Whether each pair contact searched in the last sample (after the held ones in
     /// `pair_hits`) counts in [`Outcome::own_contact`].
     pair_counts: Vec<bool>,
+    /// Buffers of the multi-evaluation.
+    multi: instants::Scratch,
 }
 
 impl Workspace {
@@ -171,6 +184,10 @@ pub struct Held {
     /// [`Outcome::own_contact`]: bodies still at their start guess, which a later stage
     /// will move anyway (see [`Held::ignore_contacts_with`]).
     ignored: Vec<bool>,
+    /// Their poses and shadow at every instant of the plan (unless it is simple).
+    instants: Vec<instants::HeldInstant>,
+    /// The stage's hold objective is `worst` ([`Held::for_stage`]).
+    worst: bool,
 }
 
 impl Held {
@@ -214,6 +231,8 @@ impl Problem {
             pair_hits: Vec::new(),
             mask: ws.mask.clone(),
             ignored: vec![false; n],
+            instants: Vec::new(),
+            worst: self.plan.worst,
         };
         if base.iter().any(|x| !x.is_finite()) || self.spins_too_fast(base) {
             return held;
@@ -234,19 +253,32 @@ impl Problem {
                 if held.varying[i] || held.varying[j] || both_fixed {
                     continue;
                 }
-                if let Some(tc) = self.pair_contact(i, &ws.flights, j, &ws.flights, scene.t) {
+                if let Some(tc) =
+                    self.pair_contact(i, &ws.flights, j, &ws.flights, self.plan.horizon)
+                {
                     held.pair_hits.push((tc, key - 1, i, j));
                 }
             }
         }
         self.shadow_with(None, Some(&kept), &mut ws);
         held.mask = ws.mask.clone();
+        held.instants = self.hold_instants(&kept, &mut ws);
         held.flights = std::mem::take(&mut ws.flights);
         held
     }
 
     pub fn new(scene: Scene) -> Problem {
         let target = TargetData::new(&scene.target);
+        let pictures = if scene.pictures.len() == 1 {
+            vec![target.clone()]
+        } else {
+            scene
+                .pictures
+                .iter()
+                .map(|p| TargetData::new(&p.target))
+                .collect()
+        };
+        let plan = Plan::of(&scene);
         let shapes = scene
             .occluders
             .iter()
@@ -273,6 +305,8 @@ impl Problem {
         Problem {
             scene,
             target,
+            pictures,
+            plan,
             shapes,
             table_shape,
             closed,
@@ -304,13 +338,14 @@ impl Problem {
             table_hit: vec![None; n],
             pair_hits: Vec::with_capacity(n * n.saturating_sub(1) / 2),
             pair_counts: Vec::with_capacity(n * n.saturating_sub(1) / 2),
+            multi: instants::Scratch::new(n, &self.plan),
         }
     }
 
     /// Evaluate one sample. `params` holds 6 values per occluder (`v` then `w`); values of
     /// non-launched occluders are ignored. Terms with weight 0 are skipped.
     pub fn evaluate(&self, params: &[f64], weights: &Weights, ws: &mut Workspace) -> Evaluation {
-        self.evaluate_sample(None, params, weights, ws)
+        self.evaluate_sample(None, params, weights, REFERENCE_DRAW, ws)
     }
 
     /// [`Problem::evaluate`] of a sample that differs from `held`'s base only in the
@@ -330,7 +365,20 @@ impl Problem {
                 .all(|i| Launch::get(params, i) == Launch::get(&held.base, i)),
             "a held occluder's launch values differ from the held base"
         );
-        self.evaluate_sample(Some(held), params, weights, ws)
+        self.evaluate_sample(Some(held), params, weights, REFERENCE_DRAW, ws)
+    }
+
+    /// [`Problem::evaluate_held`] with the perturbed launches of a robust plan drawn from
+    /// `draw` (the optimiser's per-iteration seed); other plans ignore it.
+    pub fn evaluate_held_draw(
+        &self,
+        held: &Held,
+        params: &[f64],
+        weights: &Weights,
+        draw: u64,
+        ws: &mut Workspace,
+    ) -> Evaluation {
+        self.evaluate_sample(Some(held), params, weights, draw, ws)
     }
 
     fn evaluate_sample(
@@ -338,11 +386,15 @@ impl Problem {
         held: Option<&Held>,
         params: &[f64],
         weights: &Weights,
+        draw: u64,
         ws: &mut Workspace,
     ) -> Evaluation {
-        debug_assert_eq!(params.len(), self.scene.variable_count());
+        debug_assert_eq!(params.len(), self.variable_count());
         if params.iter().any(|x| !x.is_finite()) || self.spins_too_fast(params) {
             return Evaluation::diverged();
+        }
+        if !self.plan.simple() {
+            return self.evaluate_plan(held, params, weights, draw, ws);
         }
         let outcome = self.fly_with(held, params, ws);
         self.shadow_with(held.map(|h| &h.mask), held.map(|h| &h.varying[..]), ws);
@@ -363,7 +415,8 @@ impl Problem {
     /// launch does, and the asymmetric-body integrator's step grid grows with the turn.
     fn spins_too_fast(&self, params: &[f64]) -> bool {
         self.scene.occluders.iter().enumerate().any(|(i, o)| {
-            o.launched && Launch::get(params, i).angular_velocity.length() * self.scene.t > MAX_TURN
+            o.launched
+                && Launch::get(params, i).angular_velocity.length() * self.plan.horizon > MAX_TURN
         })
     }
 
@@ -372,13 +425,8 @@ impl Problem {
         let scene = &self.scene;
         for (i, o) in scene.occluders.iter().enumerate() {
             if o.launched && among(which, i) {
-                ws.flights[i].reset(
-                    &o.mass,
-                    LaunchState::of(o, Launch::get(params, i)),
-                    scene.gravity,
-                    scene.t,
-                    &self.flight,
-                );
+                let state = self.launch_state(params, i);
+                self.start_flight(&mut ws.flights[i], i, state, 0.0, self.plan.horizon);
             }
         }
     }
@@ -452,7 +500,7 @@ impl Problem {
     /// every contact that can change the outcome is still found, whatever the order.
     fn first_contact(&self, held: Option<&Held>, ws: &mut Workspace) -> Outcome {
         let scene = &self.scene;
-        let t = scene.t;
+        let t = self.plan.horizon;
         let n = scene.occluders.len();
         let varies = |i: usize| held.is_none_or(|h| h.varying[i]);
         let ignored = |i: usize| held.is_some_and(|h| h.ignored[i]);
@@ -575,7 +623,7 @@ impl Problem {
             shape: &self.shapes[i],
             radius: scene.occluders[i].bounding_radius,
         };
-        let c = contact::table_contact(&body, table, ts, scene.t);
+        let c = contact::table_contact(&body, table, ts, self.plan.horizon);
         (c.filter(|c| c.landed).map(|c| c.time), c.map(|c| c.time))
     }
 
@@ -667,8 +715,16 @@ impl Problem {
         ws: &Workspace,
         raw: &mut [f64; TERM_COUNT],
     ) {
+        self.physics_terms(params, outcome, raw);
+        self.hint_and_barrier(&self.scene.hints, &self.target, ws, raw);
+    }
+
+    /// The contact term (contact time before the horizon times the count) and the
+    /// regularization.
+    fn physics_terms(&self, params: &[f64], outcome: &Outcome, raw: &mut [f64; TERM_COUNT]) {
         let scene = &self.scene;
-        raw[Term::Contact as usize] = (scene.t - outcome.t_sim) * outcome.n_contacts as f64;
+        raw[Term::Contact as usize] =
+            (self.plan.horizon - outcome.t_sim) * outcome.n_contacts as f64;
         let mut reg = 0.0;
         for (i, o) in scene.occluders.iter().enumerate() {
             if o.launched {
@@ -680,20 +736,6 @@ impl Problem {
             }
         }
         raw[Term::Reg as usize] = reg;
-        let cam = &scene.camera;
-        let mut hint = 0.0;
-        for h in &scene.hints {
-            let (p, q) = ws.poses[h.occluder];
-            let world = p + q * h.point;
-            hint += h.weight * self.target.hint_distance(cam.project(world), h.pixel);
-        }
-        raw[Term::Hint as usize] = hint;
-        let mut barrier = 0.0;
-        for (i, o) in scene.occluders.iter().enumerate() {
-            let (p, q) = ws.poses[i];
-            barrier += self.target.barrier(cam.project(p + q * o.mass.local_com));
-        }
-        raw[Term::Barrier as usize] = barrier;
     }
 
     /// Whether each occluder's shadow at `t` (poses from the last sample in `ws`) lies
@@ -743,6 +785,7 @@ impl Problem {
         for (k, &i) in vary.iter().enumerate() {
             Launch::copy(x, k, out, i);
         }
+        self.expand_positions(vary, x, out);
     }
 
     /// Time each phase of one sample, averaged over `reps` repetitions on this thread

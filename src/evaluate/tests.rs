@@ -152,3 +152,160 @@ fn shadows_in_image_tells_a_shadow_cut_by_the_image_edge() {
         assert!(!p.shadows_in_image(&ws)[0], "{name}");
     }
 }
+
+/// Mickey with its scene edited by `edit` (pictures, hold, positions), rebuilt.
+fn mickey_with(edit: impl FnOnce(&mut crate::scene::Scene)) -> Problem {
+    let mut s = scene("mickey").scene;
+    edit(&mut s);
+    Problem::new(s)
+}
+
+/// The image and scene energy of every instant of `p`'s plan, each on its own.
+fn instant_energies(p: &Problem, params: &[f64], w: &Weights) -> Vec<f64> {
+    let mut ws = p.workspace();
+    p.fly(params, &mut ws);
+    p.plan
+        .instants
+        .iter()
+        .map(|inst| {
+            p.shadow_at(inst.t, &mut ws);
+            let mut r = [0.0; TERM_COUNT];
+            energy::image_terms(&p.pictures[inst.picture], &ws.mask, w, &mut r);
+            let pic = &p.scene.pictures[inst.picture];
+            p.hint_and_barrier(&pic.hints, &p.pictures[inst.picture], &ws, &mut r);
+            energy::weighted_total(&r, w)
+        })
+        .collect()
+}
+
+#[test]
+fn a_hold_scores_the_mean_or_the_worst_of_its_instants() {
+    use crate::scene::{Hold, HoldObjective};
+    for objective in [HoldObjective::Mean, HoldObjective::Worst] {
+        let p = mickey_with(|s| {
+            s.hold = Some(Hold {
+                window: 0.1,
+                instants: Some(5),
+                fps: 60.0,
+                objective,
+            })
+        });
+        assert_eq!(p.plan.instants.len(), 5);
+        assert!((p.plan.instants.iter().map(|i| i.weight).sum::<f64>() - 1.0).abs() < 1e-15);
+        // The instant at t is evaluated last, so that the workspace ends with its shadow.
+        assert_eq!(p.plan.instants[4].t, p.scene.t);
+        assert!((p.plan.horizon - 1.3).abs() < 1e-12);
+        let params = p.start_parameters();
+        let w = p.scene.stages[1].weights;
+        let e = p.evaluate(&params, &w, &mut p.workspace());
+        let energies = instant_energies(&p, &params, &w);
+        let physics = w.get(Term::Contact) * e.raw[Term::Contact as usize]
+            + w.get(Term::Reg) * e.raw[Term::Reg as usize];
+        let image = match objective {
+            HoldObjective::Mean => energies.iter().sum::<f64>() / 5.0,
+            HoldObjective::Worst => energies.iter().copied().fold(f64::MIN, f64::max),
+        };
+        let want = image + physics;
+        assert!(
+            (e.total - want).abs() <= 1e-9 * want.abs(),
+            "{objective:?}: {} vs {want}",
+            e.total
+        );
+        // The mean and the worst differ here: the test can tell them apart.
+        let mean = energies.iter().sum::<f64>() / 5.0;
+        assert!(energies.iter().any(|&x| (x - mean).abs() > 1e-3 * mean));
+    }
+}
+
+#[test]
+fn a_sequence_forbids_contacts_up_to_its_last_picture() {
+    // Mickey's start guess has its head meet an ear at 1.15 s: after a picture at 1.1 s,
+    // before one at 1.2 s.
+    let early = |s: &mut crate::scene::Scene| {
+        s.t = 1.1;
+        s.pictures[0].t = 1.1;
+    };
+    let single = mickey_with(early);
+    let params = scene("mickey").start_parameters();
+    let w = Weights::all_ones();
+    let e = single.evaluate(&params, &w, &mut single.workspace());
+    assert_eq!(e.outcome.n_contacts, 0);
+    let sequence = mickey_with(|s| {
+        let mut first = s.pictures[0].clone();
+        first.t = 1.1;
+        first.weight = 0.5;
+        s.pictures[0].weight = 0.5;
+        s.pictures.insert(0, first);
+    });
+    assert_eq!(sequence.plan.horizon, 1.2);
+    let e = sequence.evaluate(&params, &w, &mut sequence.workspace());
+    assert!(e.outcome.n_contacts > 0 && e.outcome.t_sim > 1.1 && e.outcome.t_sim < 1.2);
+    // The reported IoU is the worse picture's.
+    let frames = sequence.frame_ious(&params, &mut sequence.workspace());
+    assert_eq!(frames.len(), 2);
+    assert_eq!(e.iou, frames[0].iou.min(frames[1].iou));
+}
+
+#[test]
+fn robust_samples_share_their_errors_within_a_draw() {
+    let mut p = scene("mickey");
+    p.set_robust(Robust {
+        tolerances: crate::sim::launch_error::Tolerances::default(),
+        draws: 4,
+        reference_draws: 8,
+        quantile: None,
+    });
+    assert_eq!(p.plan.shadows_per_sample(), 5);
+    let params = p.start_parameters();
+    let w = p.scene.stages[1].weights;
+    let held = p.hold(&params, &[0, 1, 2]);
+    let mut ws = p.workspace();
+    let at =
+        |draw: u64, ws: &mut Workspace| p.evaluate_held_draw(&held, &params, &w, draw, ws).total;
+    let a = at(11, &mut ws);
+    assert_eq!(a.to_bits(), at(11, &mut p.workspace()).to_bits());
+    assert_ne!(a, at(12, &mut ws));
+    // The reference draw is what `evaluate` scores.
+    let r = p.evaluate(&params, &w, &mut ws).total;
+    assert_eq!(r.to_bits(), at(REFERENCE_DRAW, &mut ws).to_bits());
+    // Without errors the robust terms are the nominal ones: a zero tolerance gives the
+    // nominal energy.
+    let mut exact = scene("mickey");
+    let plain = exact.evaluate(&params, &w, &mut exact.workspace()).total;
+    exact.set_robust(Robust {
+        tolerances: crate::sim::launch_error::Tolerances::from_array([0.0; 5]),
+        draws: 3,
+        reference_draws: 3,
+        quantile: Some(0.5),
+    });
+    let zero = exact.evaluate(&params, &w, &mut exact.workspace()).total;
+    assert!((zero - plain).abs() <= 1e-9 * plain, "{zero} vs {plain}");
+}
+
+#[test]
+fn free_positions_penalise_launches_off_the_table_or_overlapping() {
+    let p = mickey_with(|s| s.positions = crate::scene::LaunchPositions::Free);
+    let mut params = p.start_parameters();
+    assert_eq!(params.len(), 8 * 3);
+    assert_eq!(p.launch_violations(None, &params), (0, 0.0));
+    let w = p.scene.stages[1].weights;
+    let ok = p.evaluate(&params, &w, &mut p.workspace()).total;
+    // The head (at (0, -2)) moved onto the left ear (at (-2.3, 0.9)).
+    params[18] = -2.3;
+    params[19] = 2.9;
+    let (bad, depth) = p.launch_violations(None, &params);
+    assert!(bad >= 1 && depth > 0.5, "{bad} {depth}");
+    assert!(p.evaluate(&params, &w, &mut p.workspace()).total > 1e9);
+    // Off the 40 m table.
+    params[18] = 25.0;
+    params[19] = 0.0;
+    assert_eq!(p.launch_violations(None, &params).0, 1);
+    // A position moves the launch: the same offset in the scene gives the same sample.
+    params[18] = 0.5;
+    params[19] = 0.25;
+    let moved = p.evaluate(&params, &w, &mut p.workspace());
+    let fixed = mickey_with(|s| s.occluders[0].position += DVec3::new(0.5, 0.25, 0.0));
+    let again = fixed.evaluate(&params[..18], &w, &mut fixed.workspace());
+    assert_eq!(moved.total.to_bits(), again.total.to_bits());
+    assert_ne!(moved.total, ok);
+}

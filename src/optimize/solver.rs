@@ -28,10 +28,12 @@ use rayon::prelude::*;
 
 use crate::energy::DIVERGED_ENERGY;
 use crate::energy::{Term, Weights};
-use crate::evaluate::{Evaluation, Held, Problem, Workspace};
+use crate::evaluate::{Evaluation, Held, Physics, Problem, Workspace};
 use crate::optimize::cmaes::{Cmaes, CmaesConfig, StopReason};
 use crate::optimize::moves;
-use crate::output::solution::{OccluderLaunch, SampleRecord, Solution, StageReport, TermValue};
+use crate::output::solution::{
+    FrameRecord, OccluderLaunch, RobustRecord, SampleRecord, Solution, StageReport, TermValue,
+};
 use crate::scene::{Contacts, Launch, Stage};
 use crate::shadow::mask::Mask;
 
@@ -102,7 +104,9 @@ impl Pool {
         Pool { pool, workspaces }
     }
 
-    /// Evaluate every row of `candidates` (`n` values each, the stage's subset) into `out`.
+    /// Evaluate every row of `candidates` (`n` values each, the stage's subset) into `out`;
+    /// `draw` seeds the launch errors of a robust plan (the same for the whole population).
+    #[allow(clippy::too_many_arguments)]
     fn evaluate(
         &self,
         problem: &Problem,
@@ -110,6 +114,7 @@ impl Pool {
         stage: &Stage,
         candidates: &[f64],
         n: usize,
+        draw: u64,
         out: &mut [Evaluation],
     ) {
         let base = held.base();
@@ -123,7 +128,7 @@ impl Pool {
                     let mut ws = self.workspaces[idx]
                         .lock()
                         .unwrap_or_else(|e| e.into_inner());
-                    *slot = problem.evaluate_held(held, params, &stage.weights, &mut ws);
+                    *slot = problem.evaluate_held_draw(held, params, &stage.weights, draw, &mut ws);
                 },
             );
         });
@@ -223,13 +228,13 @@ pub fn solve(
         // Reports of a stage that a stop cut short are dropped: that stage runs again,
         // starting from the saved best.
         Some(s) => (
-            s.parameters(),
+            resume_parameters(problem, s),
             s.stages_completed,
             Vec::new(),
             s.stages[..s.stages_completed.min(s.stages.len())].to_vec(),
             s.wall_time_s,
         ),
-        None => (scene.start_parameters(), 0, Vec::new(), Vec::new(), 0.0),
+        None => (problem.start_parameters(), 0, Vec::new(), Vec::new(), 0.0),
     };
     let mut aborted = false;
     // Occluders that no stage has varied yet (a resumed solve has varied those of its
@@ -249,18 +254,19 @@ pub fn solve(
         observer.stage_started(k, stage);
         let stage_start = Instant::now();
         let interrupts_at_start = interrupts.load(Ordering::SeqCst);
-        let n = Launch::LEN * stage.vary.len();
+        let n = problem.stage_variable_count(&stage.vary);
         let mut x0 = vec![0.0; n];
         let mut evals: Vec<Evaluation> = Vec::new();
         let mut fitness: Vec<f64> = Vec::new();
         // What the stage holds fixed, computed once: a sample only pays for what varies.
-        let mut held = problem.hold(&params, &stage.vary);
+        let mut held = problem.hold(&params, &stage.vary).for_stage(stage);
         // Bodies no stage has moved yet are still at their start guess: the body being
         // placed need not go around them (they will move), only around those placed.
         held.ignore_contacts_with(&unplaced);
         for &i in &stage.vary {
             unplaced[i] = false;
         }
+        let robust = problem.plan.robust.is_some();
         // The stage's own record of its best: the stage starts from the previous best,
         // which it must never end worse than.
         let mut best_params = params.clone();
@@ -308,9 +314,7 @@ pub fn solve(
             }
             let start_from = moved.promising;
             let from = start_from.as_deref().unwrap_or(&best_params);
-            for (j, &i) in stage.vary.iter().enumerate() {
-                Launch::copy(from, i, &mut x0, j);
-            }
+            problem.stage_start(from, &stage.vary, &mut x0);
             let config = CmaesConfig {
                 population: Some(population),
                 max_generations: stage.max_iterations,
@@ -333,7 +337,9 @@ pub fn solve(
                     break None;
                 }
                 candidates.copy_from_slice(cma.ask());
-                pool.evaluate(problem, &held, stage, &candidates, n, &mut evals);
+                // Common random numbers: one draw of launch errors per iteration.
+                let draw = stage_seed(stage_seed(seed, k), iteration);
+                pool.evaluate(problem, &held, stage, &candidates, n, draw, &mut evals);
                 let mut improved = None;
                 for (j, e) in evals.iter().enumerate() {
                     fitness[j] = rank_value(e, scene.contacts);
@@ -343,10 +349,26 @@ pub fn solve(
                         terms: e.weighted(&stage.weights),
                         total: e.total,
                     });
-                    if fitness[j] < rank_value(&best_eval, scene.contacts) {
+                    if !robust && fitness[j] < rank_value(&best_eval, scene.contacts) {
                         best_eval = *e;
                         improved = Some(j);
                     }
+                }
+                if robust {
+                    // Energies of different iterations met different errors: the
+                    // iteration's best is compared with the stage's best on the
+                    // reference draw.
+                    improved = best_on_reference(
+                        problem,
+                        &held,
+                        stage,
+                        &params,
+                        &candidates,
+                        &fitness,
+                        &mut best_eval,
+                        &mut scratch,
+                        &mut ws,
+                    );
                 }
                 if let Some(j) = improved {
                     problem.expand(
@@ -458,6 +480,55 @@ pub fn solve(
     (s, records)
 }
 
+/// The launch values a resumed solve starts from: the saved launch, and with free
+/// positions the saved positions as offsets from the scene's.
+fn resume_parameters(problem: &Problem, s: &Solution) -> Vec<f64> {
+    let mut p = s.parameters();
+    let n = problem.scene.occluders.len();
+    p.resize(problem.variable_count(), 0.0);
+    if problem.plan.free_positions {
+        for (i, (o, l)) in problem.scene.occluders.iter().zip(&s.occluders).enumerate() {
+            if let Some(pos) = l.position {
+                let k = Launch::LEN * n + crate::evaluate::instants::POSITION_LEN * i;
+                p[k] = pos[0] - o.position.x;
+                p[k + 1] = pos[1] - o.position.y;
+            }
+        }
+    }
+    p
+}
+
+/// The robust stage's bookkeeping of its best: the iteration's best-ranked candidate,
+/// evaluated on the reference draw, replaces `best` if it does better there. Returns its
+/// index if it did.
+#[allow(clippy::too_many_arguments)]
+fn best_on_reference(
+    problem: &Problem,
+    held: &Held,
+    stage: &Stage,
+    params: &[f64],
+    candidates: &[f64],
+    fitness: &[f64],
+    best: &mut Evaluation,
+    scratch: &mut [f64],
+    ws: &mut Workspace,
+) -> Option<usize> {
+    let n = candidates.len() / fitness.len();
+    let j = (0..fitness.len()).min_by(|&a, &b| fitness[a].total_cmp(&fitness[b]))?;
+    problem.expand(
+        params,
+        &stage.vary,
+        &candidates[j * n..(j + 1) * n],
+        scratch,
+    );
+    let e = problem.evaluate_held(held, scratch, &stage.weights, ws);
+    let contacts = problem.scene.contacts;
+    (rank_value(&e, contacts) < rank_value(best, contacts)).then(|| {
+        *best = e;
+        j
+    })
+}
+
 /// How far a solve got, as [`summarize`] records it.
 #[derive(Clone, Copy, Debug)]
 pub struct Run {
@@ -508,10 +579,12 @@ pub fn summarize(
                 launched: o.launched,
                 velocity: launch.velocity.to_array(),
                 angular_velocity: launch.angular_velocity.to_array(),
+                position: (problem.plan.free_positions && o.launched)
+                    .then(|| problem.launch_position(params, i).to_array()),
             }
         })
         .collect();
-    Solution {
+    let mut s = Solution {
         scene: scene.name.clone(),
         scene_file: Some(
             std::path::absolute(&scene.source)
@@ -536,5 +609,38 @@ pub fn summarize(
         threads,
         time_per_term_us: timing.unwrap_or_default().into_iter().collect(),
         stages: reports.to_vec(),
+        frames: Vec::new(),
+        shadows_per_sample: None,
+        air: None,
+        robust: None,
+    };
+    describe_plan(problem, params, &mut ws, &mut s);
+    s
+}
+
+/// What a solution records of a plan beyond one shadow at `t`: the IoU at every frame,
+/// the shadows per sample, the air and the launch errors.
+fn describe_plan(problem: &Problem, params: &[f64], ws: &mut Workspace, s: &mut Solution) {
+    let plan = &problem.plan;
+    if !problem.scene.single_instant() {
+        s.frames = problem
+            .frame_ious(params, ws)
+            .into_iter()
+            .map(|f| FrameRecord {
+                t_s: f.t,
+                picture: f.picture,
+                iou: f.iou,
+            })
+            .collect();
     }
+    let shadows = plan.shadows_per_sample();
+    s.shadows_per_sample = (shadows > 1).then_some(shadows);
+    if let Physics::Air { config, .. } = &plan.physics {
+        s.air = Some(*config);
+    }
+    s.robust = plan.robust.map(|r| RobustRecord {
+        tolerances: r.tolerances,
+        draws: r.draws,
+        quantile: r.quantile,
+    });
 }

@@ -65,8 +65,16 @@ pub struct Comparison {
 /// Compare the Cycles shadow `cycles` with the rasterizer's shadow at `t` of the launch
 /// values `params`.
 pub fn compare(problem: &Problem, params: &[f64], cycles: &Mask) -> Comparison {
+    compare_at(problem, params, problem.scene.t, cycles)
+}
+
+/// [`compare`] at the instant `time` (a picture's instant of a scene with several).
+pub fn compare_at(problem: &Problem, params: &[f64], time: f64, cycles: &Mask) -> Comparison {
     let mut ws = problem.workspace();
     problem.evaluate(params, &Weights::all_ones(), &mut ws);
+    if time != problem.scene.t {
+        problem.shadow_at(time, &mut ws);
+    }
     let ours = &ws.mask;
     let difference = picture::difference_image(
         cycles.width(),

@@ -13,6 +13,11 @@
 //!
 //! in m/s and rad/s, world frame; `angular_velocity` defaults to zero. Every launched
 //! occluder needs an entry; occluders that are not launched stay put and need none.
+//!
+//! A solve with free launch positions moved its bodies: a `solution.json` carries their
+//! positions exactly, a `launch.csv` to the micrometre (its centre-of-mass columns);
+//! [`read_launches`] moves the scene's bodies there. A `solution.json` of a solve with air
+//! in the loop also carries its air.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -21,7 +26,21 @@ use glam::DVec3;
 use serde::Deserialize;
 
 use crate::output::solution::{check_solution, MismatchError, Solution};
-use crate::scene::{Launch, Scene};
+use crate::scene::{Launch, LaunchPositions, Scene};
+use crate::sim::drag::DragConfig;
+
+/// What a launch file holds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Launches {
+    /// Six values per occluder ([`Launch`]).
+    pub params: Vec<f64>,
+    /// The air the launch is meant for (a `solution.json` of `bsa solve --air`).
+    pub air: Option<DragConfig>,
+}
+
+/// A launch table's centre of mass farther than this (m) from the scene's moves the body:
+/// the table keeps positions to the micrometre.
+const MOVED: f64 = 2e-6;
 
 /// Why a launch file cannot be used for a scene.
 #[derive(Debug, thiserror::Error)]
@@ -93,8 +112,9 @@ struct Entry {
 
 /// The launch values in `path` for `scene`: a `.csv` file is read as a launch table, a
 /// JSON file as a `solution.json` (checked with [`check_solution`]) when it has the
-/// solution's fields, else as a minimal launch file.
-pub fn read_launches(path: &Path, scene: &Scene) -> Result<Vec<f64>> {
+/// solution's fields, else as a minimal launch file. The scene's bodies are moved to the
+/// file's launch positions where it gives others (free positions).
+pub fn read_launches(path: &Path, scene: &mut Scene) -> Result<Launches> {
     let text = std::fs::read_to_string(path).map_err(|source| LaunchFileError::Io {
         path: path.to_path_buf(),
         source,
@@ -107,7 +127,8 @@ pub fn read_launches(path: &Path, scene: &Scene) -> Result<Vec<f64>> {
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("csv"))
     {
-        return from_table(path, &text, scene);
+        let params = from_table(path, &text, scene)?;
+        return Ok(Launches { params, air: None });
     }
     let value: serde_json::Value =
         serde_json::from_str(&text).map_err(|e| format(format!("not JSON: {e}")))?;
@@ -118,7 +139,11 @@ pub fn read_launches(path: &Path, scene: &Scene) -> Result<Vec<f64>> {
             path: path.to_path_buf(),
             source,
         })?;
-        return Ok(solution.parameters());
+        solution.place(scene);
+        return Ok(Launches {
+            params: solution.parameters(),
+            air: solution.air,
+        });
     }
     let entries: HashMap<String, Entry> = serde_json::from_value(value).map_err(|e| {
         format(format!(
@@ -137,11 +162,13 @@ pub fn read_launches(path: &Path, scene: &Scene) -> Result<Vec<f64>> {
             e.angular_velocity,
         ));
     }
-    assemble(path, scene, launches)
+    let params = assemble(path, scene, launches)?;
+    Ok(Launches { params, air: None })
 }
 
-/// The rows of a launch table: `name`, `vx_m_s`.. `vz_m_s`, `wx_rad_s`.. `wz_rad_s`.
-fn from_table(path: &Path, text: &str, scene: &Scene) -> Result<Vec<f64>> {
+/// The rows of a launch table: `name`, `vx_m_s`.. `vz_m_s`, `wx_rad_s`.. `wz_rad_s`, and
+/// where given the centre of mass at launch (`com_x_m`.. `com_z_m`).
+fn from_table(path: &Path, text: &str, scene: &mut Scene) -> Result<Vec<f64>> {
     let format = |message: String| LaunchFileError::Format {
         path: path.to_path_buf(),
         message,
@@ -164,11 +191,29 @@ fn from_table(path: &Path, text: &str, scene: &Scene) -> Result<Vec<f64>> {
                 column,
             })?;
     }
+    let com_at: Option<Vec<usize>> = ["com_x_m", "com_y_m", "com_z_m"]
+        .iter()
+        .map(|c| headers.iter().position(|h| h == *c))
+        .collect();
     let mut launches = Vec::new();
     for (r, row) in reader.records().enumerate() {
         let place = format!("row {}", r + 2);
         let row = row.map_err(|e| format(format!("{place}: {e}")))?;
         let name = row.get(at[0]).unwrap_or("").to_string();
+        if let (Some(cols), Some(i)) = (&com_at, scene.occluder_index(&name)) {
+            let com: Option<Vec<f64>> = cols
+                .iter()
+                .map(|&c| row.get(c).and_then(|f| f.trim().parse::<f64>().ok()))
+                .collect();
+            if let Some(c) = com.filter(|c| c.iter().all(|x| x.is_finite())) {
+                let o = &mut scene.occluders[i];
+                let c = DVec3::from_array([c[0], c[1], c[2]]);
+                if o.launched && c.distance(o.launch_com()) > MOVED {
+                    o.position = c - o.orientation * o.mass.local_com;
+                    scene.positions = LaunchPositions::Fixed;
+                }
+            }
+        }
         let mut x = [0.0; 6];
         for k in 0..6 {
             let field = row.get(at[k + 1]).unwrap_or("");

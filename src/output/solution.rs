@@ -11,6 +11,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::energy::TERM_COUNT;
 use crate::scene::Scene;
+use crate::sim::drag::DragConfig;
+use crate::sim::launch_error::Tolerances;
 
 /// One evaluated sample: a row of `convergence.csv`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -34,6 +36,33 @@ pub struct OccluderLaunch {
     /// Launch angular velocity (rad/s, world).
     #[serde(rename = "angular_velocity_rad_s", alias = "angular_velocity")]
     pub angular_velocity: [f64; 3],
+    /// Body origin at launch (m, world), when a solve with free positions moved it from
+    /// the scene's; every command that reads the solution launches it from there.
+    #[serde(
+        rename = "launch_position_m",
+        default,
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub position: Option<[f64; 3]>,
+}
+
+/// The IoU at one frame (a picture's instant, or a frame of its hold window).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FrameRecord {
+    pub t_s: f64,
+    /// Index of the picture (0 for the first).
+    pub picture: usize,
+    pub iou: f64,
+}
+
+/// The launch errors a robust solve optimised under.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RobustRecord {
+    pub tolerances: Tolerances,
+    /// Perturbed launches per sample.
+    pub draws: usize,
+    /// The quantile of the image energy optimised; none: its mean.
+    pub quantile: Option<f64>,
 }
 
 /// Value of one energy term.
@@ -94,6 +123,20 @@ pub struct Solution {
     /// Mean time per phase of one sample on one core (microseconds).
     pub time_per_term_us: std::collections::BTreeMap<String, f64>,
     pub stages: Vec<StageReport>,
+    /// The IoU at every frame the scene asks about (several pictures, or a hold window);
+    /// empty for a single picture without hold, whose IoU is `iou`. With frames, `iou`
+    /// is the worst of the evaluated instants.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub frames: Vec<FrameRecord>,
+    /// Shadows scored per sample (instants times launches), when more than one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shadows_per_sample: Option<usize>,
+    /// The air the solve flew every body through (`bsa solve --air`); none: vacuum.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub air: Option<DragConfig>,
+    /// The launch errors of a robust solve (`bsa solve --robust`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robust: Option<RobustRecord>,
 }
 
 impl Solution {
@@ -103,6 +146,17 @@ impl Solution {
             .iter()
             .flat_map(|o| o.velocity.iter().chain(o.angular_velocity.iter()).copied())
             .collect()
+    }
+
+    /// The scene as this solution launches it: every occluder at its saved launch
+    /// position (free positions), and the positions fixed from then on.
+    pub fn place(&self, scene: &mut Scene) {
+        for (o, l) in scene.occluders.iter_mut().zip(&self.occluders) {
+            if let Some(p) = l.position {
+                o.position = glam::DVec3::from_array(p);
+            }
+        }
+        scene.positions = crate::scene::LaunchPositions::Fixed;
     }
 }
 
@@ -217,6 +271,7 @@ mod tests {
             launched: true,
             velocity: [1.0, 2.0, 3.0],
             angular_velocity: [4.0, 5.0, 6.0],
+            position: None,
         };
         let text = serde_json::to_string(&o).unwrap();
         assert!(text.contains("\"velocity_m_s\"") && text.contains("\"angular_velocity_rad_s\""));

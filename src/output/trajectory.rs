@@ -5,10 +5,12 @@
 //! Data flow of [`track`]: from launch to `t` the poses come from the solver's own model
 //! ([`Problem::fly`] and [`Problem::state_at`]: exact free flight, landings absorbed by the
 //! table), with a key at every timestep and one exactly at `t`, so that the animation
-//! shows at `t` exactly the shadow the solver scored. From `t` on, rapier3d continues the
-//! motion with collisions, landing and bouncing ([`crate::sim::continuation`]) until every
-//! body is at rest on the table or the floor, or a cap (by default [`DEFAULT_MAX_AFTER`]
-//! seconds after `t`); [`Track::rest`] says which.
+//! shows at `t` exactly the shadow the solver scored. A scene with several pictures has a
+//! key exactly at each picture's instant, and one with a hold window at each frame of
+//! the window; the solver's model runs to the end of the last window. From there on,
+//! rapier3d continues the motion with collisions, landing and bouncing
+//! ([`crate::sim::continuation`]) until every body is at rest on the table or the floor,
+//! or a cap (by default [`DEFAULT_MAX_AFTER`] seconds); [`Track::rest`] says which.
 
 use glam::{DQuat, DVec3};
 use serde::Serialize;
@@ -31,10 +33,13 @@ pub struct Track {
     pub t_index: usize,
     /// Frames per second the animation is meant for (1 / timestep).
     pub fps: f64,
-    /// Keys from `t_index` on come from the rapier continuation.
+    /// Keys from `continuation_from` on come from the rapier continuation (the key at
+    /// `t`, or at the end of the last hold window).
     pub continuation_from: usize,
     /// How the continuation ended: every body at rest, or stopped at the cap.
     pub rest: Rest,
+    /// Index of the key at each picture's instant (`scene.pictures`).
+    pub instant_indices: Vec<usize>,
 }
 
 impl Track {
@@ -66,7 +71,7 @@ pub const DEFAULT_MAX_AFTER: f64 = 30.0;
 /// (see [`crate::sim::continuation::REST_SPEED_M_S`]), or `t + max_after`.
 pub fn track(problem: &Problem, params: &[f64], max_after: f64) -> Track {
     let scene = &problem.scene;
-    let (t, dt) = (scene.t, scene.dt);
+    let (t, dt, end) = (scene.t, scene.dt, scene.horizon());
     let n = scene.occluders.len();
     let mut ws = problem.workspace();
     problem.fly(params, &mut ws);
@@ -74,22 +79,38 @@ pub fn track(problem: &Problem, params: &[f64], max_after: f64) -> Track {
         fps: 1.0 / dt,
         ..Track::default()
     };
-    // Keys at every step before t; a step closer than a thousandth of a step to t is
-    // replaced by the key at t itself.
+    // Keys at every step before the end of the model; a step closer than a thousandth of
+    // a step to an instant a picture is scored at is replaced by the key at that instant.
+    let exact = exact_keys(scene);
+    let mut next = 0;
     let mut k = 0usize;
     loop {
         let time = k as f64 * dt;
-        if time >= t - 1e-3 * dt {
+        if time >= end - 1e-3 * dt {
             break;
         }
-        out.times.push(time);
+        while next < exact.len() && exact[next] < time - 1e-3 * dt {
+            out.times.push(exact[next]);
+            next += 1;
+        }
+        if next < exact.len() && (exact[next] - time).abs() <= 1e-3 * dt {
+            out.times.push(exact[next]);
+            next += 1;
+        } else {
+            out.times.push(time);
+        }
+        k += 1;
+    }
+    out.times
+        .extend(exact[next..].iter().filter(|&&e| e < end - 1e-3 * dt));
+    for &time in &out.times {
         out.poses
             .push((0..n).map(|i| problem.state_at(&ws, i, time).0).collect());
-        k += 1;
     }
     let start: Vec<BodyState> = (0..n)
         .map(|i| {
-            let ((origin, orientation), (velocity, angular_velocity)) = problem.state_at(&ws, i, t);
+            let ((origin, orientation), (velocity, angular_velocity)) =
+                problem.state_at(&ws, i, end);
             BodyState {
                 origin,
                 orientation,
@@ -102,20 +123,42 @@ pub fn track(problem: &Problem, params: &[f64], max_after: f64) -> Track {
     let frames = continuation::simulate(
         scene,
         &start,
-        t,
+        end,
         Until::Rest { max_steps },
         &ContinuationConfig::default(),
     );
     out.rest = frames.rest;
-    out.t_index = out.times.len();
-    out.continuation_from = out.t_index;
+    out.continuation_from = out.times.len();
     for (time, poses) in frames.times.into_iter().zip(frames.poses) {
         out.times.push(time);
         out.poses.push(poses);
     }
-    // Frame 0 of the continuation is the start state itself: the exact pose at t.
-    out.poses[out.t_index] = start.iter().map(|s| (s.origin, s.orientation)).collect();
+    // Frame 0 of the continuation is the start state itself: the exact pose at the end.
+    out.poses[out.continuation_from] = start.iter().map(|s| (s.origin, s.orientation)).collect();
+    let index_of = |time: f64| {
+        out.times
+            .iter()
+            .position(|&k| k == time)
+            .unwrap_or(out.continuation_from)
+    };
+    out.t_index = index_of(t);
+    out.instant_indices = scene.pictures.iter().map(|p| index_of(p.t)).collect();
     out
+}
+
+/// The instants the animation has a key at exactly, in order, before the end of the
+/// model: every picture's instant and every frame of its hold window.
+fn exact_keys(scene: &crate::scene::Scene) -> Vec<f64> {
+    let offsets = scene.hold.as_ref().map_or(vec![0.0], |h| h.frame_offsets());
+    let mut keys: Vec<f64> = scene
+        .pictures
+        .iter()
+        .flat_map(|p| offsets.iter().map(move |o| p.t + o))
+        .filter(|&k| k > 0.0 && k < scene.horizon())
+        .collect();
+    keys.sort_by(f64::total_cmp);
+    keys.dedup();
+    keys
 }
 
 /// Rounds to 6 decimals: micrometres, micrometres per second, microradians per second
@@ -342,7 +385,7 @@ pub fn trajectory_rows(problem: &Problem, tr: &Track) -> Vec<TrajectoryRow> {
             rows.push(TrajectoryRow {
                 time_s: *time,
                 occluder: o.name.clone(),
-                phase: if k <= tr.t_index {
+                phase: if k <= tr.continuation_from {
                     "flight"
                 } else {
                     "continuation"

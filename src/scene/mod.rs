@@ -77,6 +77,7 @@ type Result<T> = std::result::Result<T, SceneError>;
 
 mod bounds;
 mod launch;
+mod pictures;
 mod raw;
 mod start;
 mod validate;
@@ -170,6 +171,8 @@ pub struct Stage {
     pub restarts: usize,
     /// IoU at `t` from which a stage no longer restarts (0 to 1).
     pub restart_iou: f64,
+    /// How a hold window's instants add up in this stage (default: `hold.objective`).
+    pub objective: Option<HoldObjective>,
 }
 
 /// Which strategy produced the stage list (kept for reports).
@@ -179,16 +182,94 @@ pub enum Strategy {
     Sequential { order: Vec<usize> },
 }
 
+/// One picture of the scene: a target and the instant the shadows must form it at.
+#[derive(Clone, Debug)]
+pub struct Picture {
+    /// The target picture, one bit per pixel (true = shadow).
+    pub target: Mask,
+    /// The target's file (for reports).
+    pub file: PathBuf,
+    /// The instant (s).
+    pub t: f64,
+    /// Its share of the image energy: the pictures' weights sum to 1.
+    pub weight: f64,
+    /// The hints aimed at this picture.
+    pub hints: Vec<Hint>,
+}
+
+/// A picture that must hold over a window of time around its instant, not only at it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Hold {
+    /// Half-width of the window (s): the picture at `t` must hold from `t - window` to
+    /// `t + window`.
+    pub window: f64,
+    /// How many evenly spaced instants of the window the optimiser evaluates (ends
+    /// included); `None`: every frame at `fps`.
+    pub instants: Option<usize>,
+    /// Frames per second of the window's frames (the reports give the IoU at every one).
+    pub fps: f64,
+    /// How the instants of a window add up to the picture's image energy.
+    pub objective: HoldObjective,
+}
+
+/// How the instants of a hold window add up to the picture's image energy.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HoldObjective {
+    /// Their mean: the weighted sum with equal weights.
+    Mean,
+    /// The worst instant's: the picture must hold at every frame, the ends of the
+    /// window included (the mean favours the middle).
+    Worst,
+}
+
+impl Hold {
+    /// The frames of the window as offsets from the picture's instant (s): `k / fps` for
+    /// every integer `k` with `|k / fps| <= window`, in order (0 among them).
+    pub fn frame_offsets(&self) -> Vec<f64> {
+        let k = (self.window * self.fps + 1e-9).floor() as i64;
+        (-k..=k).map(|i| i as f64 / self.fps).collect()
+    }
+
+    /// The offsets (s) from the picture's instant that the optimiser evaluates: the
+    /// frames, or `instants` evenly spaced from `-window` to `window`.
+    pub fn offsets(&self) -> Vec<f64> {
+        match self.instants {
+            None => self.frame_offsets(),
+            Some(n) => (0..n)
+                .map(|i| self.window * (2.0 * i as f64 / (n - 1) as f64 - 1.0))
+                .collect(),
+        }
+    }
+}
+
+/// Where the launched bodies start from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LaunchPositions {
+    /// From their positions in the scene file.
+    Fixed,
+    /// Their positions on the table (x and y; height and orientation kept) are
+    /// optimised with their launch, bounded to the table's top and contact-free at
+    /// launch.
+    Free,
+}
+
 /// A fully validated scene. Every field is resolved and in range.
 #[derive(Clone, Debug)]
 pub struct Scene {
     pub name: String,
     /// The scene file this was loaded from.
     pub source: PathBuf,
-    /// The target picture, one bit per pixel (true = shadow).
+    /// The target picture, one bit per pixel (true = shadow): the last picture's.
     pub target: Mask,
-    /// The instant at which the shadow must match (s).
+    /// The instant at which the shadow must match (s): the last picture's. The solver's
+    /// model runs to it (to the end of its hold window with `hold`).
     pub t: f64,
+    /// Every picture, by instant (one in the single-target form).
+    pub pictures: Vec<Picture>,
+    /// The window over which each picture must hold, if any.
+    pub hold: Option<Hold>,
+    /// Fixed (the default) or free launch positions.
+    pub positions: LaunchPositions,
     /// Simulation and animation timestep (s).
     pub dt: f64,
     pub gravity: DVec3,
@@ -246,6 +327,17 @@ impl Scene {
     pub fn occluder_index(&self, name: &str) -> Option<usize> {
         self.occluders.iter().position(|o| o.name == name)
     }
+
+    /// The last instant the solver's model runs to: `t`, or the end of the last
+    /// picture's hold window.
+    pub fn horizon(&self) -> f64 {
+        self.t + self.hold.as_ref().map_or(0.0, |h| h.window)
+    }
+
+    /// Whether the scene asks for one shadow at `t` only (one picture, no hold).
+    pub fn single_instant(&self) -> bool {
+        self.pictures.len() == 1 && self.hold.is_none()
+    }
 }
 
 /// Node names the glTF export uses for what is not an occluder; occluders may not take
@@ -298,6 +390,11 @@ pub const MAX_RESTARTS: usize = 10;
 pub const DEFAULT_RESTART_IOU: f64 = 0.995;
 /// Most stages a scene may expand to (scheduled list, or rounds times the order).
 pub const MAX_STAGES: usize = 10_000;
+/// Most pictures of a scene (`targets`).
+pub const MAX_PICTURES: usize = 100;
+/// Most instants the optimiser evaluates per sample (pictures times hold instants).
+pub const MAX_INSTANTS: usize = 1000;
+
 /// Most triangles of one OBJ mesh after triangulation; larger meshes are refused with a
 /// clear error (decimate them first), which keeps loading and hull building to seconds.
 pub const MAX_MESH_TRIANGLES: usize = 200_000;

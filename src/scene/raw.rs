@@ -10,8 +10,14 @@ use serde::Deserialize;
 #[serde(deny_unknown_fields)]
 pub(super) struct RawScene {
     pub(super) name: Option<String>,
-    pub(super) target: String,
-    pub(super) t: f64,
+    pub(super) target: Option<String>,
+    pub(super) t: Option<f64>,
+    /// Several pictures at several instants (replaces `target` and `t`).
+    pub(super) targets: Option<Vec<RawPicture>>,
+    /// A window around every picture's instant over which the picture must hold.
+    pub(super) hold: Option<RawHold>,
+    /// `"fixed"` (default) or `"free"`: launch positions as optimisation variables.
+    pub(super) positions: Option<String>,
     pub(super) timestep: Option<f64>,
     pub(super) gravity: Option<[f64; 3]>,
     pub(super) light: [f64; 3],
@@ -103,6 +109,7 @@ pub(super) struct RawStage {
     pub(super) stagnation: Option<usize>,
     pub(super) restarts: Option<usize>,
     pub(super) restart_iou: Option<f64>,
+    pub(super) objective: Option<String>,
 }
 
 #[derive(Deserialize, Clone)]
@@ -130,4 +137,22 @@ pub(super) enum RawStrategy {
 pub(super) enum RawOrder {
     Auto(String),
     Names(Vec<String>),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawPicture {
+    pub(super) target: Option<String>,
+    pub(super) t: Option<f64>,
+    pub(super) weight: Option<f64>,
+    pub(super) hints: Option<RawHints>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawHold {
+    pub(super) window: f64,
+    pub(super) instants: Option<usize>,
+    pub(super) fps: Option<f64>,
+    pub(super) objective: Option<String>,
 }

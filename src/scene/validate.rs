@@ -35,7 +35,7 @@ impl Validator<'_> {
         }
     }
 
-    fn resolve(&self, rel: &str) -> PathBuf {
+    pub(super) fn resolve(&self, rel: &str) -> PathBuf {
         let p = Path::new(rel);
         if p.is_absolute() {
             p.to_path_buf()
@@ -49,20 +49,32 @@ impl Validator<'_> {
         if name.is_empty() || name == "." || name == ".." || name.contains(['/', '\\']) {
             return Err(self.field_err("name", "must be a non-empty name without path separators"));
         }
-        let t = self.positive_within("t", raw.t, MAX_T)?;
+        let specs = self.pictures(&raw)?;
+        let t = specs.last().expect("at least one picture").t;
         let dt = self.positive("timestep", raw.timestep.unwrap_or(DEFAULT_TIMESTEP))?;
+        let hold = match &raw.hold {
+            Some(h) => Some(self.hold(h, specs[0].t, dt)?),
+            None => None,
+        };
+        let horizon = t + hold.as_ref().map_or(0.0, |h| h.window);
+        if horizon > MAX_T {
+            return Err(self.field_err(
+                "hold.window",
+                format!("ends at {horizon} s, after the longest flight allowed ({MAX_T} s)"),
+            ));
+        }
         if dt > t {
             return Err(self.field_err("timestep", format!("must not exceed t = {t} s, got {dt}")));
         }
         // Every key from launch to t is stored (trajectory, export, continuation), so
         // their count bounds memory.
-        if t / dt > MAX_KEYS {
+        if horizon / dt > MAX_KEYS {
             return Err(self.field_err(
                 "timestep",
                 format!(
                     "gives {:.0} keys up to t = {t} s, more than the {MAX_KEYS:e} allowed; use a timestep of at least {:e} s",
-                    (t / dt).ceil(),
-                    t / MAX_KEYS
+                    (horizon / dt).ceil(),
+                    horizon / MAX_KEYS
                 ),
             ));
         }
@@ -73,7 +85,7 @@ impl Validator<'_> {
         )?;
         let light = self.vec3("light", raw.light)?;
         let receiver = self.receiver(&raw.receiver, light)?;
-        let target = self.target(&raw.target)?;
+        let target = specs.last().expect("at least one picture").target.clone();
         let camera = ShadowCamera::new(
             light,
             ImageRect {
@@ -155,29 +167,37 @@ impl Validator<'_> {
             ));
         }
         self.check_overlaps(&occluders, table.as_ref())?;
-        let hints = match &raw.hints {
-            None => Vec::new(),
-            Some(RawHints::Inline(list)) => list
-                .iter()
-                .enumerate()
-                .map(|(i, h)| self.hint(&format!("hints[{i}]"), h, &occluders))
-                .collect::<Result<_>>()?,
-            Some(RawHints::File(rel)) => self.hints_file(&self.resolve(rel), &occluders)?,
-        };
+        let pictures = self.with_hints(specs, &occluders)?;
+        let hints: Vec<Hint> = pictures.iter().flat_map(|p| p.hints.clone()).collect();
+        let positions = self.positions(raw.positions.as_deref(), table.is_some())?;
         let aim = raw
             .start
             .as_ref()
             .and_then(|s| s.aim.clone())
             .unwrap_or_else(|| "hints".to_string());
         match aim.as_str() {
-            "hints" => Aim {
-                camera: &camera,
-                receiver: &receiver,
-                t,
-                gravity,
-                rise,
+            // The earliest picture an occluder has hints in aims it (later ones first,
+            // so that earlier ones overwrite them).
+            "hints" => {
+                let free_on = table
+                    .as_ref()
+                    .filter(|_| positions == LaunchPositions::Free);
+                let explicit = raw_start_overrides(&raw);
+                let aim = |t| Aim {
+                    camera: &camera,
+                    receiver: &receiver,
+                    t,
+                    gravity,
+                    rise,
+                    free_on,
+                };
+                for p in pictures.iter().rev() {
+                    aim(p.t).apply(&mut occluders, &p.hints, &explicit);
+                }
+                if let [a, b, ..] = &pictures[..] {
+                    aim(a.t).apply_between(b.t, &b.hints, &mut occluders, &a.hints, &explicit);
+                }
             }
-            .apply(&mut occluders, &hints, &raw_start_overrides(&raw)),
             "up" => {}
             other => {
                 return Err(self.field_err(
@@ -213,6 +233,9 @@ impl Validator<'_> {
             source: self.file.to_path_buf(),
             target,
             t,
+            pictures,
+            hold,
+            positions,
             dt,
             gravity,
             light,
@@ -259,7 +282,7 @@ impl Validator<'_> {
         })
     }
 
-    fn target(&self, rel: &str) -> Result<Mask> {
+    pub(super) fn target(&self, rel: &str) -> Result<Mask> {
         let path = self.resolve(rel);
         let bytes = std::fs::read(&path).map_err(|source| SceneError::Io {
             path: path.clone(),
@@ -484,7 +507,7 @@ impl Validator<'_> {
         Ok(())
     }
 
-    fn hint(&self, field: &str, h: &RawHint, occ: &[Occluder]) -> Result<Hint> {
+    pub(super) fn hint(&self, field: &str, h: &RawHint, occ: &[Occluder]) -> Result<Hint> {
         let occluder = occ
             .iter()
             .position(|o| o.name == h.occluder)
@@ -509,7 +532,7 @@ impl Validator<'_> {
 
     /// Hints in a text file, one per line: `occluder x y z px py [weight]`; `#` starts a
     /// comment. This is the paper's "hints stored separately in a text file".
-    fn hints_file(&self, path: &Path, occ: &[Occluder]) -> Result<Vec<Hint>> {
+    pub(super) fn hints_file(&self, path: &Path, occ: &[Occluder]) -> Result<Vec<Hint>> {
         let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
             path: path.to_path_buf(),
             source,
@@ -670,7 +693,9 @@ impl Validator<'_> {
                 format!("must be an IoU between 0 and 1, got {restart_iou}"),
             ));
         }
+        let objective = self.objective(&format!("{field}.objective"), rs.objective.as_deref())?;
         Ok(Stage {
+            objective,
             name: rs.name.clone().unwrap_or(default_name),
             weights: Weights(w),
             vary,

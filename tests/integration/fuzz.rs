@@ -1,7 +1,8 @@
 //! The fuzzing harness of issue #13: scene mutations generated from the schema, run
 //! against `bsa check` and, for a subset that check accepts, a short `bsa solve`, each
 //! under a timeout. Every field of a scene that uses every optional field (a sphere, a
-//! box and a mesh occluder, table, hints, start, two stages) is given a wrong type, is
+//! box and a mesh occluder, table, hints, start, a hold window, free positions, two
+//! stages) is given a wrong type, is
 //! removed, and is set to 0, -1, 1e300, -1e300, 1e-300 and 1e12; every array is also
 //! made huge. `fuzz_obj_and_png_bytes_are_handled_cleanly` does the same for the bytes of
 //! the OBJ and PNG readers (seeded flips, truncations, garbage lines). The
@@ -55,10 +56,13 @@ fn base_scene() -> Value {
             { "occluder": "head", "point": [0.0, 0.0, 0.0], "pixel": [320.0, 280.0], "weight": 1000.0 }
         ],
         "start": { "rise": 1.5, "aim": "hints" },
+        "hold": { "window": 0.05, "instants": 2, "fps": 60, "objective": "mean" },
+        "positions": "free",
         "stages": [
             { "name": "coarse", "weights": { "d0": 2, "d1": 10, "xor": 1, "hint": 0.1 }, "vary": "all", "step": 0.3,
               "max_iterations": 2, "population": 6, "target_energy": 0.0, "tol_fun": 1e-9, "stagnation": 5 },
-            { "name": "fine", "weights": { "xor": 300, "contact": 50 }, "vary": ["head"], "max_iterations": 2, "population": 6 }
+            { "name": "fine", "weights": { "xor": 300, "contact": 50 }, "vary": ["head"], "max_iterations": 2, "population": 6,
+              "objective": "worst" }
         ],
         "seed": 7
     })

@@ -12,6 +12,8 @@
 //! - `fuzz`: scene mutations generated from the schema, run through `check` and a short
 //!   solve under a timeout.
 //! - `report`: `report.html` rendered by headless Chromium.
+//! - `instants`: several shadows per sample (issue #16): hold windows, sequences, air in
+//!   the loop, robust launches, free positions, and their bad inputs.
 //!
 //! The tests that need an outside tool (Node's Khronos glTF validator, Blender's bpy, Chromium) are
 //! `#[ignore]`d with the reason, so `cargo test` lists them as ignored; when run
@@ -23,6 +25,7 @@ mod blender;
 mod cli;
 mod exports;
 mod fuzz;
+mod instants;
 mod render;
 mod report;
 mod robust;

@@ -69,8 +69,8 @@ pub fn example_scenes() -> Vec<PathBuf> {
     v
 }
 
-/// Solve a scene quickly (few iterations) into a fresh folder with the CLI, which also
-/// writes the .glb and the CSV tables.
+/// Solve a scene quickly (few iterations, one round) into a fresh folder with the CLI,
+/// which also writes the .glb and the CSV tables.
 pub fn quick_solve(scene: &Path, name: &str) -> PathBuf {
     let d = tmpdir(name);
     let text = std::fs::read_to_string(scene.join("scene.json")).unwrap();
@@ -79,9 +79,20 @@ pub fn quick_solve(scene: &Path, name: &str) -> PathBuf {
     let abs = |p: &serde_json::Value| {
         serde_json::Value::from(scene.join(p.as_str().unwrap()).display().to_string())
     };
-    v["target"] = abs(&v["target"]);
+    if v.get("target").is_some() {
+        v["target"] = abs(&v["target"]);
+    }
     if let Some(h) = v.get("hints").filter(|h| h.is_string()).cloned() {
         v["hints"] = abs(&h);
+    }
+    // A sequence: every picture's target.
+    for p in v
+        .get_mut("targets")
+        .and_then(|t| t.as_array_mut())
+        .into_iter()
+        .flatten()
+    {
+        p["target"] = abs(&p["target"]);
     }
     for o in v["occluders"].as_array_mut().unwrap() {
         if let Some(obj) = o["shape"].get("mesh").map(|m| m["obj"].clone()) {
@@ -91,6 +102,14 @@ pub fn quick_solve(scene: &Path, name: &str) -> PathBuf {
     if let Some(stages) = v.get_mut("stages").and_then(|s| s.as_array_mut()) {
         for s in stages {
             s["max_iterations"] = 4.into();
+        }
+    }
+    if let Some(st) = v.get_mut("strategy").filter(|s| s["kind"] == "sequential") {
+        st["rounds"] = 1.into();
+        for k in ["stage", "final"] {
+            if st.get(k).is_some() {
+                st[k]["max_iterations"] = 4.into();
+            }
         }
     }
     std::fs::write(d.join("scene.json"), serde_json::to_string(&v).unwrap()).unwrap();

@@ -307,7 +307,7 @@ pub fn write_glb_with_launches(
 
     flight_animation(&mut b, traj, &occluder_nodes)?;
 
-    let extras = serde_json::json!({
+    let mut extras = serde_json::json!({
         "t": scene.t,
         "fps": traj.fps,
         "t_frame": scene.t * traj.fps,
@@ -317,6 +317,25 @@ pub fn write_glb_with_launches(
         "scene": scene.name,
         "generator": GENERATOR,
     });
+    if !scene.single_instant() {
+        // Every picture's instant (a marker each in Blender), and the hold window.
+        extras["instants"] = scene
+            .pictures
+            .iter()
+            .enumerate()
+            .map(|(k, p)| {
+                serde_json::json!({
+                    "picture": k + 1,
+                    "t": p.t,
+                    "frame": p.t * traj.fps,
+                    "target": p.file.file_name().map(|f| f.to_string_lossy().into_owned()),
+                })
+            })
+            .collect();
+        if let Some(h) = &scene.hold {
+            extras["hold_window_s"] = serde_json::json!(h.window);
+        }
+    }
     let gltf_scene = b.root.push(json::Scene {
         extensions: None,
         extras: Some(serde_json::value::to_raw_value(&extras)?),

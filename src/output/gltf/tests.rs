@@ -82,6 +82,7 @@ fn ballistic(scene: &Scene) -> Track {
         fps: 1.0 / dt,
         continuation_from: n_t,
         rest: Default::default(),
+        instant_indices: vec![n_t],
     }
 }
 

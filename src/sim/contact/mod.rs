@@ -106,6 +106,30 @@ impl Motion<'_> {
     fn is_flying(&self) -> bool {
         matches!(self, Motion::Flying(_))
     }
+
+    /// Gravity as the flight sees it (zero for a body that stays put).
+    fn gravity(&self) -> DVec3 {
+        match self {
+            Motion::Flying(f) => match f.drag_accel_bound() {
+                None => f.com_velocity(1.0) - f.com_velocity(0.0),
+                Some(_) => f.gravity(),
+            },
+            Motion::Fixed { .. } => DVec3::ZERO,
+        }
+    }
+
+    /// A bound of the acceleration besides gravity (air drag; 0 on a parabola).
+    fn extra_accel(&self) -> f64 {
+        match self {
+            Motion::Flying(f) => f.drag_accel_bound().unwrap_or(0.0),
+            Motion::Fixed { .. } => 0.0,
+        }
+    }
+
+    /// Whether the centre of mass moves on the exact parabola (no drag).
+    fn parabolic(&self) -> bool {
+        self.extra_accel() == 0.0
+    }
 }
 
 /// One participant of a pair query.
@@ -152,7 +176,8 @@ pub fn pair_contact_time(a: &Body, b: &Body, horizon: f64) -> Option<f64> {
     // good (two flying bodies only; then no contact is possible afterwards).
     let mut end = horizon;
     // 1. Bounding spheres about the centres of mass.
-    let s0 = if both_fly {
+    let extra = a.motion.extra_accel() + b.motion.extra_accel();
+    let s0 = if both_fly && extra == 0.0 {
         // Gravity cancels: d(s) = d0 + dv s exactly.
         let d0 = b.motion.com(0.0) - a.motion.com(0.0);
         let dv = b.motion.com_velocity(0.0) - a.motion.com_velocity(0.0);
@@ -160,12 +185,16 @@ pub fn pair_contact_time(a: &Body, b: &Body, horizon: f64) -> Option<f64> {
         end = s_out;
         s_in
     } else {
-        let g = if a.motion.is_flying() {
-            a.motion.com_velocity(1.0) - a.motion.com_velocity(0.0)
+        // One body flies (relative gravity) or drag bends the paths (relative
+        // acceleration at most the drag bounds): conservative advancement.
+        let g = if both_fly {
+            DVec3::ZERO
+        } else if a.motion.is_flying() {
+            a.motion.gravity()
         } else {
-            b.motion.com_velocity(1.0) - b.motion.com_velocity(0.0)
+            b.motion.gravity()
         };
-        let gn = g.length();
+        let gn = g.length() + extra;
         let mut s = 0.0;
         let mut steps = 0;
         loop {
@@ -193,9 +222,8 @@ pub fn pair_contact_time(a: &Body, b: &Body, horizon: f64) -> Option<f64> {
         return Some(s0);
     }
     // 3. Conservative advancement on the true shapes.
-    let g_rel = (b.motion.com_velocity(1.0) - b.motion.com_velocity(0.0))
-        - (a.motion.com_velocity(1.0) - a.motion.com_velocity(0.0));
-    let gn = g_rel.length();
+    let g_rel = b.motion.gravity() - a.motion.gravity();
+    let gn = g_rel.length() + extra;
     let spin = a.motion.max_angular_speed() * a.radius + b.motion.max_angular_speed() * b.radius;
     let mut s = s0;
     let mut warm = Warm::default();
@@ -280,9 +308,8 @@ fn linear_overlap_interval(d0: DVec3, dv: DVec3, reach: f64, horizon: f64) -> Op
 
 /// Contact time of two bodies that touch at launch (signed distance `d0` <= 1 um).
 fn touching_pair_contact_time(a: &Body, b: &Body, d0: f64, horizon: f64) -> Option<f64> {
-    let g_rel = (b.motion.com_velocity(1.0) - b.motion.com_velocity(0.0))
-        - (a.motion.com_velocity(1.0) - a.motion.com_velocity(0.0));
-    let gn = g_rel.length();
+    let g_rel = b.motion.gravity() - a.motion.gravity();
+    let gn = g_rel.length() + a.motion.extra_accel() + b.motion.extra_accel();
     let spin = a.motion.max_angular_speed() * a.radius + b.motion.max_angular_speed() * b.radius;
     let sink_floor = d0.min(0.0) - TABLE_PENETRATION;
     let mut left = false;
@@ -353,12 +380,13 @@ pub fn table_contact(
         Motion::Flying(f) => f,
         Motion::Fixed { .. } => return None,
     };
-    if let ContactShape::Ball(r) = body.shape {
+    let parabolic = body.motion.parabolic();
+    if let (ContactShape::Ball(r), true) = (body.shape, parabolic) {
         if let Some(answer) = ball_table_closed_form(flight, *r, table, horizon) {
             return answer;
         }
     }
-    let g = (flight.com_velocity(1.0) - flight.com_velocity(0.0)).length();
+    let g = body.motion.gravity().length() + body.motion.extra_accel();
     let spin = flight.max_angular_speed() * body.radius;
     let mut left = false;
     let mut s = 0.0;
@@ -379,7 +407,7 @@ pub fn table_contact(
             let landed = left && flight.com_velocity(s).z < 0.0;
             return Some(TableContact { time: s, landed });
         }
-        if left {
+        if left && parabolic {
             // While the bounding sphere is above the top face, nothing can touch the
             // table: jump to when its lowest point could come back down to the top.
             if let Some(next) = sphere_clear_of_top(flight, body.radius, table, s, horizon) {

@@ -553,3 +553,111 @@ fn overlapping_piece_hulls_never_read_as_separated() {
     }
     assert!(worst > -1e-3, "the poses are near touching ({worst})");
 }
+
+/// The first time two flights come within `reach` of each other (centres), by sampling
+/// every 0.1 ms: the reference of the drag tests.
+fn sampled_meeting(a: &FreeFlight, b: &FreeFlight, reach: f64, horizon: f64) -> Option<f64> {
+    (0..=(horizon * 1e4) as usize)
+        .map(|k| k as f64 * 1e-4)
+        .find(|&t| a.com(t).distance(b.com(t)) <= reach)
+}
+
+#[test]
+fn contacts_under_drag_are_found_where_the_bent_paths_meet() {
+    use crate::sim::drag::{BodyDrag, DragConfig};
+    let g = DVec3::new(0.0, 0.0, -9.81);
+    let (r, ball) = (0.05, Shape::Sphere { radius: 0.05 });
+    // A light ball (drag bends its path by decimetres) thrown across a heavy one's, a
+    // little higher each time: some throws meet in air, others pass.
+    let heavy = BodyDrag::new(&ball, 5.0, &DragConfig::default());
+    let light = BodyDrag::new(&ball, 0.02, &DragConfig::default());
+    let make = |pos: DVec3, v: DVec3, d: Option<&BodyDrag>| {
+        let mut f = flight(&ball, pos, v, DVec3::ZERO, g, 1.5);
+        if let Some(d) = d {
+            f.set_drag(d, 0.01);
+        }
+        f
+    };
+    let shape = ContactShape::new(&ball);
+    fn body<'a>(f: &'a FreeFlight, shape: &'a ContactShape, r: f64) -> Body<'a> {
+        Body {
+            motion: Motion::Flying(f),
+            shape,
+            radius: r,
+        }
+    }
+    let (mut met, mut passed) = (0, 0);
+    for k in 0..24 {
+        let vz = 4.0 + 0.05 * k as f64;
+        let (pa, va) = (DVec3::new(-2.0, 0.0, 1.0), DVec3::new(3.0, 0.0, vz));
+        let (pb, vb) = (DVec3::new(2.0, 0.0, 1.0), DVec3::new(-2.0, 0.0, 4.0));
+        let (a, b) = (make(pa, va, Some(&light)), make(pb, vb, Some(&heavy)));
+        assert!(a.drag_accel_bound().is_some());
+        let want = sampled_meeting(&a, &b, 2.0 * r, 1.5);
+        let got = pair_contact_time(&body(&a, &shape, r), &body(&b, &shape, r), 1.5);
+        match (got, want) {
+            (Some(t), Some(w)) => {
+                met += 1;
+                assert!(t <= w + 1e-9 && w - t < 1.5e-4, "vz {vz}: {t} vs {w}");
+            }
+            (None, None) => passed += 1,
+            _ => panic!("vz {vz}: search {got:?}, sampled {want:?}"),
+        }
+        // In a vacuum the same throws meet otherwise: drag is in the search.
+        let (av, bv) = (make(pa, va, None), make(pb, vb, None));
+        let vacuum = pair_contact_time(&body(&av, &shape, r), &body(&bv, &shape, r), 1.5);
+        if got.is_some() {
+            assert_ne!(vacuum, got, "vz {vz}");
+        }
+    }
+    assert!(met >= 2 && passed >= 2, "{met} meetings, {passed} misses");
+}
+
+#[test]
+fn a_ball_in_air_lands_where_its_drag_flight_meets_the_table() {
+    use crate::sim::drag::{BodyDrag, DragConfig};
+    let g = DVec3::new(0.0, 0.0, -9.81);
+    let s = Shape::Sphere { radius: 0.05 };
+    let table = Table {
+        center: DVec3::new(0.0, 0.0, -0.5),
+        half_extents: DVec3::new(20.0, 20.0, 0.5),
+    };
+    let ts = table_shape(&table);
+    let mut f = flight(
+        &s,
+        DVec3::new(0.0, 0.0, 0.05),
+        DVec3::new(1.0, 0.0, 4.0),
+        DVec3::ZERO,
+        g,
+        2.0,
+    );
+    f.set_drag(&BodyDrag::new(&s, 0.02, &DragConfig::default()), 0.01);
+    let shape = ContactShape::new(&s);
+    let c = table_contact(
+        &Body {
+            motion: Motion::Flying(&f),
+            shape: &shape,
+            radius: 0.05,
+        },
+        &table,
+        &ts,
+        2.0,
+    )
+    .expect("it lands");
+    assert!(c.landed);
+    let want = (1..200_000)
+        .map(|k| k as f64 * 1e-5)
+        .find(|&t| f.com(t).z <= 0.05)
+        .unwrap();
+    assert!((c.time - want).abs() < 2e-5, "{} vs {want}", c.time);
+    // In a vacuum it lands later (drag slows the climb and the fall less than it gains).
+    let v = flight(
+        &s,
+        DVec3::new(0.0, 0.0, 0.05),
+        DVec3::new(1.0, 0.0, 4.0),
+        DVec3::ZERO,
+        g,
+        2.0,
+    );
+    assert!((v.com(c.time).z - 0.05).abs() > 1e-3);
+}

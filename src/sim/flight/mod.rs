@@ -22,6 +22,7 @@ use glam::{DQuat, DVec3};
 
 use crate::geometry::shape::MassProperties;
 use crate::scene::{Launch, Occluder};
+use crate::sim::drag::{BodyDrag, DragTrack};
 
 /// Relative tolerance under which two principal moments count as equal, so that the
 /// closed-form isotropic or axisymmetric rotation is used. At 1e-9 the closed form's
@@ -158,6 +159,9 @@ pub struct FreeFlight {
     inv_h: f64,
     /// Principal-to-world quaternions at `k h`, `k = 0..=n` (asymmetric only).
     states: Vec<DQuat>,
+    /// The centre of mass flown with drag, when `drag_on` (see [`FreeFlight::set_drag`]).
+    drag: DragTrack,
+    drag_on: bool,
 }
 
 impl Default for FreeFlight {
@@ -181,6 +185,8 @@ impl Default for FreeFlight {
             h: 0.0,
             inv_h: 0.0,
             states: Vec::new(),
+            drag: DragTrack::default(),
+            drag_on: false,
         }
     }
 }
@@ -285,6 +291,7 @@ impl FreeFlight {
         self.precession = DVec3::ZERO;
         self.spin_body = DVec3::ZERO;
         self.states.clear();
+        self.drag_on = false;
 
         let [i0, i1, i2] = inertia.to_array();
         let tol = EQUAL_MOMENT_RTOL * inertia.max_element();
@@ -348,15 +355,39 @@ impl FreeFlight {
         }
     }
 
-    /// Centre of mass at time `t` (world): `x0 + v t + g t^2 / 2`.
+    /// From now on (until the next reset) the centre of mass flies through air: quadratic
+    /// drag of `body` (and Magnus lift if its model has it, with the launch spin), RK4
+    /// on a grid of at most `max_step` over `[0, t_max]` ([`DragTrack`]). The rotation
+    /// stays the torque-free one (the drag model has no torque).
+    pub fn set_drag(&mut self, body: &BodyDrag, max_step: f64) {
+        let w0 = self.angular_velocity(0.0);
+        self.drag
+            .reset(body, self.com0, self.v0, w0, self.g, self.t_max, max_step);
+        self.drag_on = true;
+    }
+
+    /// With drag on ([`FreeFlight::set_drag`]), an upper bound of the magnitude of the
+    /// acceleration besides gravity; `None` for the exact parabola.
+    pub fn drag_accel_bound(&self) -> Option<f64> {
+        self.drag_on.then(|| self.drag.accel_bound())
+    }
+
+    /// Centre of mass at time `t` (world): `x0 + v t + g t^2 / 2` (with drag: the drag
+    /// flight's).
     #[inline]
     pub fn com(&self, t: f64) -> DVec3 {
+        if self.drag_on {
+            return self.drag.state(t).0;
+        }
         self.com0 + self.v0 * t + self.g * (0.5 * t * t)
     }
 
     /// Centre-of-mass velocity at time `t` (world).
     #[inline]
     pub fn com_velocity(&self, t: f64) -> DVec3 {
+        if self.drag_on {
+            return self.drag.state(t).1;
+        }
         self.v0 + self.g * t
     }
 
@@ -407,6 +438,12 @@ impl FreeFlight {
     #[inline]
     pub fn max_angular_speed(&self) -> f64 {
         self.w_max
+    }
+
+    /// Gravity (m/s^2).
+    #[inline]
+    pub fn gravity(&self) -> DVec3 {
+        self.g
     }
 
     /// World angular momentum about the centre of mass (constant).
