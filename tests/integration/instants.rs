@@ -362,8 +362,10 @@ fn air_solve_records_its_air_and_every_command_flies_through_it() {
     };
     let (vacuum, air) = (iou(&[]), iou(&["--air"]));
     assert!((air - s["iou"].as_f64().unwrap()).abs() < 1e-3, "{air}");
+    // (Drag moves fly's blocks by centimetres by t: the short solve's picture loses a few
+    // hundredths of IoU in a vacuum, far beyond the 1e-3 of the same table in air.)
     assert!(
-        vacuum < air - 0.05,
+        vacuum < air - 0.02,
         "the air table in a vacuum: {vacuum}, in air {air}"
     );
 }
