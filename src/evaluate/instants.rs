@@ -362,6 +362,19 @@ impl Problem {
         out
     }
 
+    /// [`Problem::evaluate_held`] with the perturbed launches of a robust plan drawn from
+    /// `draw` (the optimiser's per-iteration seed); other plans ignore it.
+    pub fn evaluate_held_draw(
+        &self,
+        held: &Held,
+        params: &[f64],
+        weights: &Weights,
+        draw: u64,
+        ws: &mut Workspace,
+    ) -> Evaluation {
+        self.evaluate_sample(Some(held), params, weights, draw, ws)
+    }
+
     /// One sample under the plan (see the module docs); `draw` seeds the perturbed
     /// launches.
     pub(super) fn evaluate_plan(

@@ -368,20 +368,7 @@ impl Problem {
         self.evaluate_sample(Some(held), params, weights, REFERENCE_DRAW, ws)
     }
 
-    /// [`Problem::evaluate_held`] with the perturbed launches of a robust plan drawn from
-    /// `draw` (the optimiser's per-iteration seed); other plans ignore it.
-    pub fn evaluate_held_draw(
-        &self,
-        held: &Held,
-        params: &[f64],
-        weights: &Weights,
-        draw: u64,
-        ws: &mut Workspace,
-    ) -> Evaluation {
-        self.evaluate_sample(Some(held), params, weights, draw, ws)
-    }
-
-    fn evaluate_sample(
+    pub(super) fn evaluate_sample(
         &self,
         held: Option<&Held>,
         params: &[f64],

@@ -4,17 +4,8 @@
 
 use std::path::Path;
 
+use crate::scene_errors::assert_rejected as rejected;
 use crate::util::{bsa, quick_solve, root, tmpdir, variant};
-
-/// `bsa check` on a bad scene fails cleanly, naming what is at fault.
-fn rejected(dir: &Path, expect: &[&str]) {
-    let (ok, _, err) = bsa(&["check", dir.to_str().unwrap()]);
-    assert!(!ok, "accepted a bad scene in {}", dir.display());
-    assert!(!err.contains("panicked"), "panicked: {err}");
-    for e in expect {
-        assert!(err.contains(e), "error message lacks `{e}`:\n{err}");
-    }
-}
 
 fn read_json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()

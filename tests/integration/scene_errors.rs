@@ -6,7 +6,7 @@ use std::path::Path;
 use crate::util::{bsa, tmpdir, variant};
 
 /// `bsa check` on a bad scene must fail cleanly, naming the file and the field.
-fn assert_rejected(dir: &Path, expect: &[&str]) {
+pub fn assert_rejected(dir: &Path, expect: &[&str]) {
     let (ok, _, err) = bsa(&["check", dir.to_str().unwrap()]);
     assert!(!ok, "accepted a bad scene in {}", dir.display());
     assert!(!err.contains("panicked"), "panicked: {err}");
