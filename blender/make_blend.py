@@ -210,6 +210,9 @@ def main():
     scene.frame_end = plan["frame_end"]
     scene.frame_step = 1
     scene.timeline_markers.new("t", frame=t_frame)
+    # A sequence's later pictures: one marker each.
+    for m in plan["markers"]:
+        scene.timeline_markers.new(m["label"], frame=m["frame"])
 
     roles = B.classify()
     colls = organise(bpy, scene, roles)

@@ -119,6 +119,9 @@ pub struct Plan {
     pub t_s: f64,
     /// The frame of `t`: whole.
     pub t_frame: i64,
+    /// A timeline marker for each picture after the first of a sequence (the first is the
+    /// marker `t`), at the whole frame nearest its instant.
+    pub markers: Vec<SheetFrame>,
     /// The frame of the launch (`0 <= launch_frame < 1` without slow motion before it).
     pub launch_frame: f64,
     pub frame_start: i64,
@@ -185,6 +188,16 @@ pub fn plan(problem: &Problem, track: &Track, opts: &BlendOptions) -> Result<Pla
     let map = TimeMap::new(fps, t, slow);
     let key_frames: Vec<f64> = track.times.iter().map(|&x| map.frame_of(x)).collect();
     let t_frame = map.frame_of(t).round() as i64;
+    let markers = scene
+        .pictures
+        .iter()
+        .enumerate()
+        .skip(1)
+        .map(|(k, p)| SheetFrame {
+            label: format!("picture {} ({:.2} s)", k + 1, p.t),
+            frame: map.frame_of(p.t).round() as i64,
+        })
+        .collect();
     let frame_times = match slow {
         Some(s) => {
             let a = map.frame_of(s.start - s.ramp_in).floor() as i64;
@@ -237,6 +250,7 @@ pub fn plan(problem: &Problem, track: &Track, opts: &BlendOptions) -> Result<Pla
         target_size: [scene.target.width(), scene.target.height()],
         t_s: t,
         t_frame,
+        markers,
         launch_frame: map.frame_of(0.0),
         frame_start,
         frame_end,

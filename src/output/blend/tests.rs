@@ -9,8 +9,9 @@ fn planted(name: &str) -> (Problem, Track) {
         .join("scenes")
         .join(name);
     let mut scene = crate::scene::load(&dir).unwrap();
-    let params = scene.start_parameters();
     let p = Problem::new(scene.clone());
+    // The problem's start: with free positions it carries their offsets too.
+    let params = p.start_parameters();
     let mut ws = p.workspace();
     p.evaluate(&params, &Weights::all_ones(), &mut ws);
     scene.target = ws.mask.clone();
@@ -188,4 +189,25 @@ fn bad_options_and_blank_pictures_are_refused() {
         plan(&p, &track, &options(24)),
         Err(BlendError::NoPicture(_))
     ));
+}
+
+#[test]
+fn a_sequence_gets_a_marker_for_each_later_picture() {
+    let (p, track) = planted("sequence");
+    let pictures = &p.scene.pictures;
+    assert!(pictures.len() >= 2);
+    for fps in [24, 25, 30, 60] {
+        let plan = plan(&p, &track, &options(fps)).unwrap();
+        assert_eq!(plan.markers.len(), pictures.len() - 1, "{fps} fps");
+        for (m, pic) in plan.markers.iter().zip(&pictures[1..]) {
+            // The later pictures are after t, at their own instant.
+            let expected = plan.t_frame as f64 + (pic.t - plan.t_s) * f64::from(fps);
+            assert!((m.frame as f64 - expected).abs() <= 1.0, "{fps} fps: {m:?}");
+        }
+    }
+    let (mickey, track) = planted("mickey");
+    assert!(plan(&mickey, &track, &options(24))
+        .unwrap()
+        .markers
+        .is_empty());
 }
