@@ -340,27 +340,64 @@ fn planted_pair(name: &str) -> (Problem, Vec<f64>) {
     (p, params)
 }
 
-#[test]
-fn moves_send_a_hidden_body_back_to_the_bare_part_of_the_target() {
-    use bsa::optimize::moves;
-    let (p, planted) = planted_pair("moves-hidden");
+/// Sets body `i`'s launch velocity so that its centre of mass is at `to` at `t`.
+fn aim(p: &Problem, params: &mut [f64], i: usize, to: glam::DVec3) {
+    let (t, g) = (p.scene.t, p.scene.gravity);
+    let v = (to - p.scene.occluders[i].launch_com() - 0.5 * g * t * t) / t;
+    params[6 * i..6 * i + 3].copy_from_slice(&[v.x, v.y, v.z]);
+}
+
+/// Body `i`'s centre of mass at `t` after an evaluation on `ws`.
+fn com(p: &Problem, ws: &bsa::evaluate::Workspace, i: usize) -> glam::DVec3 {
+    let (origin, q) = ws.poses[i];
+    origin + q * p.scene.occluders[i].mass.local_com
+}
+
+/// Two rounds of moves of both bodies from `params`, ranked by `rank`: the IoU before,
+/// the evaluation after and the report.
+fn run_moves(
+    p: &Problem,
+    params: &mut [f64],
+    rank: &dyn Fn(&bsa::evaluate::Evaluation) -> f64,
+) -> (
+    f64,
+    bsa::evaluate::Evaluation,
+    bsa::optimize::moves::MoveReport,
+) {
     let w = p.scene.stages.last().unwrap().weights;
     let mut ws = p.workspace();
-    assert!(p.evaluate(&planted, &w, &mut ws).iou > 0.9999);
+    let mut best = p.evaluate(params, &w, &mut ws);
+    let before = best.iou;
+    let held = p.hold(params, &[0, 1]);
+    let report = bsa::optimize::moves::improve(
+        p,
+        &held,
+        &[0, 1],
+        &w,
+        rank,
+        params,
+        &mut best,
+        2,
+        &mut ws,
+        &mut |_| {},
+    );
+    (before, best, report)
+}
+
+#[test]
+fn moves_send_a_hidden_body_back_to_the_bare_part_of_the_target() {
+    let (p, planted) = planted_pair("moves-hidden");
+    let mut ws = p.workspace();
+    assert!(
+        p.evaluate(&planted, &bsa::energy::Weights::all_ones(), &mut ws)
+            .iou
+            > 0.9999
+    );
     // The small sphere sent just below the large one, on its line of sight from the
     // light: its shadow hides in the large one's, and half the target is bare.
-    let (light, t, g) = (p.scene.camera.light, p.scene.t, p.scene.gravity);
-    let (origin, q) = ws.poses[0];
-    let large = origin + q * p.scene.occluders[0].mass.local_com;
-    let hidden = light + (large - light) * 1.08;
+    let light = p.scene.camera.light;
     let mut params = planted.clone();
-    let start = p.scene.occluders[1].launch_com();
-    let v = (hidden - start - 0.5 * g * t * t) / t;
-    params[6..9].copy_from_slice(&[v.x, v.y, v.z]);
-    let mut best = p.evaluate(&params, &w, &mut ws);
-    let before = best.iou;
-    assert!(before < 0.9, "IoU {before}");
-    let held = p.hold(&params, &[0, 1]);
+    aim(&p, &mut params, 1, light + (com(&p, &ws, 0) - light) * 1.08);
     let rank = |e: &bsa::evaluate::Evaluation| {
         if e.outcome.own_contact > 0.0 {
             f64::INFINITY
@@ -368,18 +405,8 @@ fn moves_send_a_hidden_body_back_to_the_bare_part_of_the_target() {
             e.total
         }
     };
-    let report = moves::improve(
-        &p,
-        &held,
-        &[0, 1],
-        &w,
-        &rank,
-        &mut params,
-        &mut best,
-        2,
-        &mut ws,
-        &mut |_| {},
-    );
+    let (before, best, report) = run_moves(&p, &mut params, &rank);
+    assert!(before < 0.9, "IoU {before}");
     assert!(report.accepted >= 1, "{report:?}");
     assert!(
         best.iou > 0.95 && best.iou > before + 0.05,
@@ -391,40 +418,16 @@ fn moves_send_a_hidden_body_back_to_the_bare_part_of_the_target() {
 
 #[test]
 fn moves_swap_two_bodies_that_cover_each_others_parts() {
-    use bsa::optimize::moves;
     let (p, planted) = planted_pair("moves-swap");
-    let w = p.scene.stages.last().unwrap().weights;
     let mut ws = p.workspace();
-    p.evaluate(&planted, &w, &mut ws);
+    p.evaluate(&planted, &bsa::energy::Weights::all_ones(), &mut ws);
     // Each sphere sent where the other was: the large one casts the small part's place
     // too big, and the small one the large part's too small.
-    let (t, g) = (p.scene.t, p.scene.gravity);
-    let com = |i: usize, ws: &bsa::evaluate::Workspace| {
-        let (origin, q) = ws.poses[i];
-        origin + q * p.scene.occluders[i].mass.local_com
-    };
-    let (c0, c1) = (com(0, &ws), com(1, &ws));
+    let (c0, c1) = (com(&p, &ws, 0), com(&p, &ws, 1));
     let mut params = planted.clone();
-    for (i, to) in [(0, c1), (1, c0)] {
-        let v = (to - p.scene.occluders[i].launch_com() - 0.5 * g * t * t) / t;
-        params[6 * i..6 * i + 3].copy_from_slice(&[v.x, v.y, v.z]);
-    }
-    let mut best = p.evaluate(&params, &w, &mut ws);
-    let before = best.iou;
-    let held = p.hold(&params, &[0, 1]);
-    let rank = |e: &bsa::evaluate::Evaluation| e.total;
-    moves::improve(
-        &p,
-        &held,
-        &[0, 1],
-        &w,
-        &rank,
-        &mut params,
-        &mut best,
-        2,
-        &mut ws,
-        &mut |_| {},
-    );
+    aim(&p, &mut params, 0, c1);
+    aim(&p, &mut params, 1, c0);
+    let (before, best, _) = run_moves(&p, &mut params, &|e| e.total);
     assert!(
         best.iou > before + 0.05 && best.iou > 0.9,
         "IoU {before} -> {}",
