@@ -321,14 +321,7 @@ pub fn hints(problem: &Problem, target: &Mask) -> Vec<(usize, DVec3, DVec2)> {
     }
     blobs.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.x.total_cmp(&b.1.x)));
     let occ = &problem.scene.occluders;
-    let mut order: Vec<usize> = (0..occ.len()).filter(|&i| occ[i].launched).collect();
-    order.sort_by(|&a, &b| {
-        occ[b]
-            .shape
-            .volume()
-            .total_cmp(&occ[a].shape.volume())
-            .then(a.cmp(&b))
-    });
+    let order = crate::scene::auto_order(occ);
     let mut taken = vec![0usize; blobs.len()];
     let mut out = Vec::new();
     for (rank, i) in order.into_iter().enumerate() {

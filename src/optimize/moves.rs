@@ -124,8 +124,9 @@ pub fn improve(
             {
                 promising = Some((free(&e), candidate.to_vec()));
             }
-            if rank(&e) < best_rank {
-                best_rank = rank(&e);
+            let r = rank(&e);
+            if r < best_rank {
+                best_rank = r;
                 chosen.copy_from_slice(candidate);
                 found = Some(e);
             }

@@ -84,6 +84,7 @@ mod validate;
 
 pub use launch::Launch;
 use raw::RawScene;
+pub use start::auto_order;
 use validate::Validator;
 
 // ---------------------------------------------------------------------------------

@@ -208,7 +208,7 @@ fn fits(occ: &[Occluder], i: usize, position: DVec3, table: &Table) -> bool {
 
 /// The automatic sequential order: largest occluders first, since they fix most of the
 /// picture and the small ones then fill in details around them. Ties keep file order.
-pub(super) fn auto_order(occ: &[Occluder]) -> Vec<usize> {
+pub fn auto_order(occ: &[Occluder]) -> Vec<usize> {
     let mut idx: Vec<usize> = occ
         .iter()
         .enumerate()
