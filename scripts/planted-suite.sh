@@ -11,16 +11,17 @@
 #   boxes12   8 to 12 such blocks, 2 m picture
 #   chess     6 chess pieces (scenes/thinker/pieces), 0.96 m picture, light 3 m up
 #   mix       2 or 3 spheres and 2 or 3 blocks, 1.6 m picture
-# Problems and solves go to /tmp/bsa-planted/<class>-<seed>/; prints one line per problem
+# Problems and solves go to $ROOT/<class>-<seed>/ (ROOT defaults to /tmp/bsa-planted);
+# BSA=PATH runs another binary (e.g. an older build, for a side-by-side comparison); prints one line per problem
 # and a table per class: IoU (min / median / max), solves with a contact before t,
 # samples and wall time (median).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 first=${1:-1000}
 per=${2:-6}
-cargo build --release --locked --quiet
-bsa=./target/release/bsa
-root=/tmp/bsa-planted
+if [ -z "${BSA:-}" ]; then cargo build --release --locked --quiet; fi
+bsa=${BSA:-./target/release/bsa}
+root=${ROOT:-/tmp/bsa-planted}
 mkdir -p "$root"
 results=$root/results.tsv
 : >"$results"

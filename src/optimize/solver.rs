@@ -166,6 +166,27 @@ fn profile_reps(problem: &Problem, params: &[f64], ws: &mut Workspace) -> usize 
     ((0.01 / (2.0 * sample)) as usize).clamp(5, 100)
 }
 
+/// Whether a run (its moves and its CMA-ES) moved the stage's picture enough to be worth
+/// a restart: it found a better-ranked sample, and either the run started with a contact
+/// of the stage's own or the IoU rose by at least `gain` (the stage's `restart_gain`). A run that
+/// left the picture as it was has settled, and a wider run from the same best rarely
+/// finds more: on the examples, the final joint stage's restarts after such a run never
+/// did, and cost half of the solve's time (`docs/results.md`, "Restarts").
+fn run_moved_picture(gain: f64, start: &Evaluation, end: &Evaluation, contacts: Contacts) -> bool {
+    let (a, b) = (rank_value(start, contacts), rank_value(end, contacts));
+    let better = b < a - 1e-9 * a.abs();
+    better && (start.outcome.own_contact > 0.0 || end.iou - start.iou >= gain)
+}
+
+/// Iteration cap of a stage's run: each restart doubles the population and halves the
+/// cap, so that every run draws about as many samples as the first (IPOP within a budget
+/// of `restarts + 1` first runs).
+fn run_iterations(max_iterations: usize, first_population: usize, population: usize) -> usize {
+    (max_iterations * first_population)
+        .div_ceil(population.max(1))
+        .max(1)
+}
+
 /// Seed of stage `k`'s CMA-ES: a SplitMix64 step, so that every stage of every seed has
 /// its own stream and a resumed solve draws exactly what an uninterrupted one would.
 fn stage_seed(seed: u64, k: usize) -> u64 {
@@ -289,6 +310,7 @@ pub fn solve(
             // would not (see `moves`); a run may start from a better picture with a
             // contact, which only replaces the best once its contact is gone.
             let rank = |e: &Evaluation| rank_value(e, scene.contacts);
+            let run_start = best_eval;
             let moved = moves::improve(
                 problem,
                 &held,
@@ -317,7 +339,7 @@ pub fn solve(
             problem.stage_start(from, &stage.vary, &mut x0);
             let config = CmaesConfig {
                 population: Some(population),
-                max_generations: stage.max_iterations,
+                max_generations: run_iterations(stage.max_iterations, stage.population, population),
                 f_target: stage.target_energy,
                 tol_fun: stage.tol_fun,
                 stagnation_window: stage.stagnation,
@@ -403,7 +425,8 @@ pub fn solve(
             let restartable = !interrupted
                 && stop != Some(StopReason::TargetReached)
                 && restart < stage.restarts
-                && best_eval.iou < stage.restart_iou;
+                && best_eval.iou < stage.restart_iou
+                && run_moved_picture(stage.restart_gain, &run_start, &best_eval, scene.contacts);
             if !restartable {
                 break stop;
             }
@@ -643,4 +666,48 @@ fn describe_plan(problem: &Problem, params: &[f64], ws: &mut Workspace, s: &mut 
         draws: r.draws,
         quantile: r.quantile,
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn eval(total: f64, iou: f64, own_contact: f64) -> Evaluation {
+        let mut e = Evaluation::diverged();
+        e.total = total;
+        e.iou = iou;
+        e.outcome.own_contact = own_contact;
+        e
+    }
+
+    #[test]
+    fn every_run_of_a_stage_draws_about_the_samples_of_the_first() {
+        // 80 iterations of 24, then restarts of 48, 96 and 192 (a population that does
+        // not divide the budget rounds the cap up).
+        for (population, cap) in [(24, 80), (48, 40), (96, 20), (192, 10), (500, 4)] {
+            assert_eq!(run_iterations(80, 24, population), cap);
+            assert!(cap * population >= 80 * 24 && (cap - 1) * population < 80 * 24);
+        }
+        assert_eq!(run_iterations(1, 24, 10_000), 1);
+    }
+
+    #[test]
+    fn only_a_run_that_moved_the_picture_restarts() {
+        let c = Contacts::Constraint;
+        let start = eval(1.0, 0.90, 0.0);
+        // Lower energy but the same picture: a run that settled.
+        assert!(!run_moved_picture(
+            0.001,
+            &start,
+            &eval(0.99, 0.9005, 0.0),
+            c
+        ));
+        // The picture moved by a thousandth or more.
+        assert!(run_moved_picture(0.001, &start, &eval(0.9, 0.902, 0.0), c));
+        // Nothing better at all.
+        assert!(!run_moved_picture(0.0, &start, &start, c));
+        // A run that removed its stage's contact restarts whatever the IoU did.
+        let stuck = eval(1.0, 0.95, 0.01);
+        assert!(run_moved_picture(0.001, &stuck, &eval(2.0, 0.94, 0.0), c));
+    }
 }

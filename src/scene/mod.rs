@@ -166,12 +166,16 @@ pub struct Stage {
     pub tol_fun: f64,
     /// Stop after this many iterations without improvement.
     pub stagnation: usize,
-    /// Restarts (IPOP: from the best so far, with the initial step and twice the
-    /// previous population) allowed when the stage stops with its picture below
-    /// `restart_iou`.
+    /// Restarts (IPOP: from the best so far, with the initial step, twice the previous
+    /// population and half its iteration cap, so that every run of the stage draws about
+    /// as many samples as the first) allowed when the stage stops with its picture below
+    /// `restart_iou`, after a run that raised the picture's IoU by `restart_gain`.
     pub restarts: usize,
     /// IoU at `t` from which a stage no longer restarts (0 to 1).
     pub restart_iou: f64,
+    /// IoU a run must have gained (or the run must have removed a contact) for the
+    /// stage to restart after it (0 to 1).
+    pub restart_gain: f64,
     /// How a hold window's instants add up in this stage (default: `hold.objective`).
     pub objective: Option<HoldObjective>,
 }
@@ -389,6 +393,10 @@ pub const DEFAULT_RESTARTS: usize = 2;
 pub const MAX_RESTARTS: usize = 10;
 /// IoU from which a stage no longer restarts when its file does not say.
 pub const DEFAULT_RESTART_IOU: f64 = 0.995;
+/// IoU a run must gain for its stage to restart, when the file does not say: a run that
+/// left the picture as it was (by a thousandth of its IoU) has settled where a wider run
+/// from the same best rarely finds more.
+pub const DEFAULT_RESTART_GAIN: f64 = 0.001;
 /// Most stages a scene may expand to (scheduled list, or rounds times the order).
 pub const MAX_STAGES: usize = 10_000;
 /// Most pictures of a scene (`targets`).

@@ -109,6 +109,7 @@ pub(super) struct RawStage {
     pub(super) stagnation: Option<usize>,
     pub(super) restarts: Option<usize>,
     pub(super) restart_iou: Option<f64>,
+    pub(super) restart_gain: Option<f64>,
     pub(super) objective: Option<String>,
 }
 

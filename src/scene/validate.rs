@@ -693,6 +693,13 @@ impl Validator<'_> {
                 format!("must be an IoU between 0 and 1, got {restart_iou}"),
             ));
         }
+        let restart_gain = rs.restart_gain.unwrap_or(DEFAULT_RESTART_GAIN);
+        if !(0.0..=1.0).contains(&restart_gain) {
+            return Err(self.field_err(
+                format!("{field}.restart_gain"),
+                format!("must be an IoU gain between 0 and 1, got {restart_gain}"),
+            ));
+        }
         let objective = self.objective(&format!("{field}.objective"), rs.objective.as_deref())?;
         Ok(Stage {
             objective,
@@ -707,6 +714,7 @@ impl Validator<'_> {
             stagnation,
             restarts,
             restart_iou,
+            restart_gain,
         })
     }
 
