@@ -9,10 +9,11 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
+use rayon::prelude::*;
 use serde_json::{json, Value};
 
 use crate::design::inventory::{AutoKind, Inventory, Kind};
-use crate::design::launch::{Geometry, Object};
+use crate::design::launch::{Geometry, Object, Plan};
 use crate::design::picture::Picture;
 use crate::design::plant::{default_strategy, Stage};
 use crate::design::{self, chess, separate, AutoRequest, Request};
@@ -223,12 +224,48 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         table_top: scene.table.as_ref().map_or(0.0, |t| t.top()),
         gravity: scene.gravity,
         t: scene.t,
+        ceiling: design::CEILINGS[0],
     };
-    let mut plan = design::design(&picture, geometry, &request)?;
-    write(&plan.scene_json(&name, "target.png", opts.seed))?;
-    let mut problem = Problem::new(load::scene(dir)?);
-    let n = plan.objects.len();
-    let sep = separate::separate(&mut plan, &mut problem, 4 * n + 10);
+    // One design per ceiling, in parallel, each written to its own file beside the
+    // scene (mesh paths are relative to the folder) and made contact-free; the start
+    // guess that reads best (contact-free first) is kept.
+    let variants: Vec<Result<Variant>> = design::CEILINGS
+        .par_iter()
+        .enumerate()
+        .map(|(k, &ceiling)| {
+            let file = dir.join(format!(".bsa-new-design-{k}.json"));
+            let variant = design_variant(
+                &picture,
+                Geometry {
+                    ceiling,
+                    ..geometry.clone()
+                },
+                &request,
+                &file,
+                &name,
+                opts.seed,
+            );
+            let _ = std::fs::remove_file(&file);
+            variant
+        })
+        .collect();
+    let mut best: Option<Variant> = None;
+    let mut first_error = None;
+    for v in variants {
+        match v {
+            Ok(v) => {
+                if best.as_ref().is_none_or(|b| v.better_than(b)) {
+                    best = Some(v);
+                }
+            }
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    let Some(Variant { plan, moves, .. }) = best else {
+        return Err(first_error.expect("every ceiling gave a design or an error"));
+    };
     write(&plan.scene_json(&name, "target.png", opts.seed))?;
     // What the user gets: the scene as written, loaded afresh.
     let problem = Problem::new(load::scene(dir)?);
@@ -244,6 +281,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         &ws.mask,
         &format!("{name}: the start guess at t, before any solve"),
     )?;
+    let n = plan.objects.len();
     let heights: Vec<f64> = (0..n).map(|k| plan.height(k)).collect();
     let chosen = n - opts.inventory.items.len();
     println!(
@@ -253,8 +291,8 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         if opts.inventory.auto.is_some() { format!(" ({chosen} chosen by auto:)") } else { String::new() },
         heights.iter().copied().fold(f64::INFINITY, f64::min),
         heights.iter().copied().fold(0.0, f64::max),
-        sep.moves,
-        if sep.moves == 1 { "" } else { "s" },
+        moves,
+        if moves == 1 { "" } else { "s" },
         start.iou,
         if start.outcome.n_contacts > 0 {
             format!("with a contact at {:.3} s (the solver treats it as a penalty)", start.outcome.t_sim)
@@ -265,6 +303,50 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         dir.display()
     );
     Ok(())
+}
+
+/// One design of the picture under one ceiling, made contact-free.
+struct Variant {
+    plan: Plan,
+    /// Moves [`separate`] took.
+    moves: usize,
+    /// The start guess's IoU and whether it flies without contact before `t`.
+    iou: f64,
+    clear: bool,
+}
+
+impl Variant {
+    /// Contact-free first, then the higher IoU.
+    fn better_than(&self, other: &Variant) -> bool {
+        (self.clear, self.iou) > (other.clear, other.iou)
+    }
+}
+
+/// Design under `geometry`'s ceiling, write the scene to `file` (in the scene's folder),
+/// make its start guess contact-free and evaluate it.
+fn design_variant(
+    picture: &Picture,
+    geometry: Geometry,
+    request: &Request,
+    file: &Path,
+    name: &str,
+    seed: u64,
+) -> Result<Variant> {
+    let mut plan = design::design(picture, geometry, request)?;
+    let json = plan.scene_json(name, "target.png", seed);
+    files::write_atomic(file, serde_json::to_string_pretty(&json)?.as_bytes())?;
+    let mut problem = Problem::new(load::scene(file)?);
+    let n = plan.objects.len();
+    let sep = separate::separate(&mut plan, &mut problem, 4 * n + 10);
+    let params = separate::apply(&plan, &mut problem);
+    let mut ws = problem.workspace();
+    let start = problem.evaluate(&params, &Weights::default(), &mut ws);
+    Ok(Variant {
+        plan,
+        moves: sep.moves,
+        iou: start.iou,
+        clear: start.outcome.n_contacts == 0,
+    })
 }
 
 /// An object whose shadow is wider than the picture cannot be part of it.

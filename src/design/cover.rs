@@ -44,19 +44,21 @@ pub struct Frame {
     pub metres_per_px: f64,
     /// Height of the light above the receiver (m).
     pub light_height: f64,
-    /// Lowest and highest magnification (heights between a tenth and four fifths of
-    /// the light's).
+    /// Lowest and highest magnification (heights between a tenth of the light's and
+    /// the ceiling).
     pub m_lo: f64,
     pub m_hi: f64,
 }
 
 impl Frame {
-    pub fn new(metres_per_px: f64, light_height: f64) -> Frame {
+    /// The frame of a picture at `metres_per_px` under a light `light_height` above
+    /// it, whose highest flight reaches `ceiling` times the light's height (less than 1).
+    pub fn new(metres_per_px: f64, light_height: f64, ceiling: f64) -> Frame {
         Frame {
             metres_per_px,
             light_height,
             m_lo: 1.0 / (1.0 - 0.1),
-            m_hi: 1.0 / (1.0 - 0.8),
+            m_hi: 1.0 / (1.0 - ceiling.clamp(0.2, 0.95)),
         }
     }
 
@@ -627,7 +629,7 @@ mod tests {
         // A vertical bar 60 x 200 px at 2.5 mm per pixel under a light 6 m up: a
         // 0.14 m block covers its length at m = 200 * 0.0025 / 0.14 = 3.57.
         let pic = picture(320, 240, &[(130, 20, 190, 220)]);
-        let cover = Cover::new(&pic, Frame::new(0.0025, 6.0));
+        let cover = Cover::new(&pic, Frame::new(0.0025, 6.0, 0.8));
         let p = cover.best(0, &block()).unwrap();
         let along = (p.theta.rem_euclid(std::f64::consts::PI) - std::f64::consts::FRAC_PI_2).abs();
         assert!(along < 0.05, "theta {}", p.theta);
@@ -649,7 +651,7 @@ mod tests {
         // A cross of two bars: two blocks, one per bar, their heights at least the
         // separation apart; and polishing keeps that.
         let pic = picture(320, 240, &[(40, 100, 280, 140), (140, 10, 180, 230)]);
-        let frame = Frame::new(0.0025, 6.0);
+        let frame = Frame::new(0.0025, 6.0, 0.8);
         let mut cover = Cover::new(&pic, frame);
         for k in 0..2 {
             let fams = block();

@@ -47,6 +47,9 @@ pub struct Geometry {
     pub table_top: f64,
     pub gravity: DVec3,
     pub t: f64,
+    /// The highest flight at `t`, as a fraction of the light's height above the
+    /// receiver (one of [`super::CEILINGS`]).
+    pub ceiling: f64,
 }
 
 impl Geometry {
@@ -54,6 +57,7 @@ impl Geometry {
         Frame::new(
             self.camera.width_m / self.camera.width_px as f64,
             self.camera.light_height(),
+            self.ceiling,
         )
     }
 }
@@ -306,6 +310,7 @@ mod tests {
             table_top: 0.0,
             gravity: DVec3::new(0.0, 0.0, -9.81),
             t: 1.2,
+            ceiling: 0.8,
         }
     }
 
