@@ -23,7 +23,7 @@ use crate::output::files;
 use crate::scene::Scene;
 
 use super::plant::Design;
-use super::{load, NewArgs};
+use super::{load, progress, NewArgs};
 
 /// The validated options of `bsa new`.
 pub(super) struct Options {
@@ -229,6 +229,13 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     // One design per ceiling, in parallel, each written to its own file beside the
     // scene (mesh paths are relative to the folder) and made contact-free; the start
     // guess that reads best (contact-free first) is kept.
+    let bar = progress::steps(
+        design::CEILINGS.len() as u64,
+        &format!(
+            "{name}: designing under {} ceilings",
+            design::CEILINGS.len()
+        ),
+    );
     let variants: Vec<Result<Variant>> = design::CEILINGS
         .par_iter()
         .enumerate()
@@ -246,9 +253,11 @@ pub(super) fn run(opts: &Options) -> Result<()> {
                 opts.seed,
             );
             let _ = std::fs::remove_file(&file);
+            bar.inc(1);
             variant
         })
         .collect();
+    bar.finish_and_clear();
     let mut best: Option<Variant> = None;
     let mut first_error = None;
     for v in variants {

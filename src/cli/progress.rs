@@ -37,6 +37,13 @@ fn bar(total: u64, template: &'static str, quiet: bool) -> ProgressBar {
     bar
 }
 
+/// A bar over `total` steps of plain work (not samples), e.g. the designs of `bsa new`.
+pub(super) fn steps(total: u64, prefix: &str) -> ProgressBar {
+    let b = bar(total, "{prefix} [{bar:30}] {pos}/{len} {elapsed}", false);
+    b.set_prefix(prefix.to_string());
+    b
+}
+
 /// The observer of `bsa solve`: draws a bar per stage, prints a line per finished stage,
 /// refreshes `preview.png`, and after every stage appends its rows to `convergence.csv`
 /// and rewrites `solution.json`, so that an interrupted solve can be resumed. The files
