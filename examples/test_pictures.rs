@@ -4,10 +4,16 @@
 //! (DejaVu Sans's airplane, chess knight and umbrella symbols), 640 x 480, black on
 //! white, each with the box of objects it is to be made of, stated before any solve.
 //!
-//! Run: `cargo run --release --example test_pictures [-- DIR]` (default
-//! `tools/test-pictures`): writes `DIR/<name>.png` and `DIR/manifest.tsv` (name,
-//! objects, extra `bsa new` options), which `scripts/new-suite.sh` reads. The output
-//! depends only on the font file and this code.
+//! Two sets: set 1 (`tools/test-pictures`), the pictures `bsa new` was developed on, and
+//! set 2 (`tools/test-pictures-2`), drawn after the code was final and solved once, for
+//! the figures of the issue: letters, digits, outlines, a filled star, a snowman of
+//! discs and two DejaVu symbols (heart and spade) as silhouettes.
+//!
+//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 or 2, default
+//! 1; DIR default `tools/test-pictures` or `tools/test-pictures-2`): writes
+//! `DIR/<name>.png` and `DIR/manifest.tsv` (name, objects, extra `bsa new` options),
+//! which `scripts/new-suite.sh` reads. The output depends only on the font file and
+//! this code.
 
 use std::error::Error;
 use std::fmt::Write as _;
@@ -59,6 +65,112 @@ fn cross(x: f64, y: f64) -> bool {
 }
 
 /// name, shape, objects, extra `bsa new` options.
+/// A regular triangle pointing up, centred on the origin, whose sides are `r` from the
+/// centre.
+fn in_triangle(x: f64, y: f64, r: f64) -> bool {
+    [-90.0f64, 30.0, 150.0].iter().all(|a| {
+        let (s, c) = a.to_radians().sin_cos();
+        x * c + y * s <= r
+    })
+}
+
+fn triangle(x: f64, y: f64) -> bool {
+    in_triangle(x, y + 30.0, 100.0) && !in_triangle(x, y + 30.0, 60.0)
+}
+
+fn frame(x: f64, y: f64) -> bool {
+    let d = x.abs().max(y.abs());
+    (110.0..=150.0).contains(&d)
+}
+
+fn star(x: f64, y: f64) -> bool {
+    // Ten vertices, outer radius 175, inner 75, a point up; even-odd ray casting.
+    let v: Vec<(f64, f64)> = (0..10)
+        .map(|k| {
+            let r = if k % 2 == 0 { 175.0 } else { 75.0 };
+            let a = 90.0f64.to_radians() + k as f64 * 36.0f64.to_radians();
+            (r * a.cos(), r * a.sin() - 15.0)
+        })
+        .collect();
+    let mut inside = false;
+    for k in 0..10 {
+        let (a, b) = (v[k], v[(k + 1) % 10]);
+        if (a.1 > y) != (b.1 > y) && x < a.0 + (y - a.1) * (b.0 - a.0) / (b.1 - a.1) {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+fn snowman(x: f64, y: f64) -> bool {
+    x.hypot(y + 100.0) <= 90.0 || x.hypot(y - 40.0) <= 65.0 || x.hypot(y - 140.0) <= 45.0
+}
+
+/// Set 2: drawn after the code was final, each with its objects stated before any solve.
+fn pictures_2() -> Vec<(&'static str, Shape, String, &'static str)> {
+    let chess_stage = "--width 0.96 --light-height 3";
+    vec![
+        (
+            "letter-h",
+            Shape::Glyph('H', 6),
+            format!("{DOUBLE}*2,{UNIT}"),
+            "",
+        ),
+        (
+            "letter-l",
+            Shape::Glyph('L', 6),
+            format!("{DOUBLE},{UNIT}"),
+            "",
+        ),
+        ("letter-t", Shape::Glyph('T', 6), format!("{DOUBLE}*2"), ""),
+        (
+            "letter-z",
+            Shape::Glyph('Z', 6),
+            format!("{DOUBLE},{UNIT}*2"),
+            "",
+        ),
+        ("letter-n", Shape::Glyph('N', 6), format!("{DOUBLE}*3"), ""),
+        (
+            "digit-1",
+            Shape::Glyph('1', 6),
+            format!("{DOUBLE},{UNIT},{HALF}"),
+            "",
+        ),
+        (
+            "digit-5",
+            Shape::Glyph('5', 6),
+            format!("{UNIT}*5,{HALF}*2"),
+            "",
+        ),
+        (
+            "triangle",
+            Shape::Drawn(triangle),
+            format!("{DOUBLE}*3"),
+            "",
+        ),
+        ("frame", Shape::Drawn(frame), format!("{DOUBLE}*4"), ""),
+        ("star", Shape::Drawn(star), format!("{UNIT}*5,{HALF}*2"), ""),
+        (
+            "snowman",
+            Shape::Drawn(snowman),
+            "sphere:0.09*3".to_string(),
+            "",
+        ),
+        (
+            "heart",
+            Shape::Glyph('\u{2665}', 0),
+            "chess".to_string(),
+            chess_stage,
+        ),
+        (
+            "spade",
+            Shape::Glyph('\u{2660}', 0),
+            "chess".to_string(),
+            chess_stage,
+        ),
+    ]
+}
+
 fn pictures() -> Vec<(&'static str, Shape, String, &'static str)> {
     let chess_stage = "--width 0.96 --light-height 3";
     vec![
@@ -253,15 +365,22 @@ fn drawn(f: fn(f64, f64) -> bool) -> Vec<bool> {
 }
 
 fn main() -> Result<(), Box<dyn Error>> {
-    let dir = std::env::args()
-        .nth(1)
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let set = args.first().map_or("1", String::as_str);
+    let (list, default_dir) = match set {
+        "1" => (pictures(), "tools/test-pictures"),
+        "2" => (pictures_2(), "tools/test-pictures-2"),
+        other => return Err(format!("SET must be 1 or 2, got {other:?}").into()),
+    };
+    let dir = args
+        .get(1)
         .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tools/test-pictures"));
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(default_dir));
     std::fs::create_dir_all(&dir)?;
     let font = FontRef::try_from_slice(include_bytes!("../assets/fonts/DejaVuSans.ttf"))?;
     let mut manifest =
         String::from("# name\tobjects\toptions (bsa new; written by examples/test_pictures.rs)\n");
-    for (name, shape, objects, options) in pictures() {
+    for (name, shape, objects, options) in list {
         let on = match shape {
             Shape::Glyph(c, d) => glyph(&font, c, d)?,
             Shape::Drawn(f) => drawn(f),

@@ -6,11 +6,13 @@
 # whole processes). The overlays are tiled into docs/images/new-suite[-auto].png.
 #
 #     bash scripts/new-suite.sh [SEED] [auto]      # defaults: seed 1, the stated boxes
+#     SET=2 bash scripts/new-suite.sh 1             # set 2 (tools/test-pictures-2)
 #
 # With `auto`, every picture gets one automatic item of its kind instead (auto:box of the
 # unit block for the block pictures, auto:sphere for the sphere one, auto:chess for the
 # chess ones) and the table gives the count chosen.
-# Scenes and solves go to /tmp/bsa-new-suite[-auto]/<picture>/ and <picture>-out/.
+# Scenes and solves go to /tmp/bsa-new-suite[-2][-auto]/<picture>/ and <picture>-out/;
+# the contact sheet to docs/images/new-suite[-2][-auto].png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seed=${1:-1}
@@ -19,10 +21,12 @@ cargo build --release --locked --quiet --bin bsa --example contact_sheet
 bsa=$(cargo metadata --format-version 1 --no-deps | python3 -c 'import json,sys; print(json.load(sys.stdin)["target_directory"])')/release
 sheet=$bsa/examples/contact_sheet
 bsa=$bsa/bsa
+set_=${SET:-1}
 pics=tools/test-pictures
-root=/tmp/bsa-new-suite
 suffix=""
-if [ "$mode" = auto ]; then root=/tmp/bsa-new-suite-auto; suffix=-auto; fi
+if [ "$set_" = 2 ]; then pics=tools/test-pictures-2; suffix=-2; fi
+if [ "$mode" = auto ]; then suffix=$suffix-auto; fi
+root=/tmp/bsa-new-suite$suffix
 mkdir -p "$root"
 rows=$root/results.tsv
 : >"$rows"
