@@ -167,11 +167,12 @@ fn profile_reps(problem: &Problem, params: &[f64], ws: &mut Workspace) -> usize 
 }
 
 /// Whether a run (its moves and its CMA-ES) moved the stage's picture enough to be worth
-/// a restart: it found a better-ranked sample, and either the run started with a contact
-/// of the stage's own or the IoU rose by at least `gain` (the stage's `restart_gain`). A run that
-/// left the picture as it was has settled, and a wider run from the same best rarely
+/// a restart: it found a better-ranked sample, and either it started with a contact of
+/// the stage's own or the IoU rose by at least `gain` (the stage's `restart_gain`). A run
+/// that left the picture as it was has settled, and a wider run from the same best rarely
 /// finds more: on the examples, the final joint stage's restarts after such a run never
-/// did, and cost half of the solve's time (`docs/results.md`, "Restarts").
+/// did, and cost half of the solve's time (`docs/results.md`, "Restarts within a
+/// budget").
 fn run_moved_picture(gain: f64, start: &Evaluation, end: &Evaluation, contacts: Contacts) -> bool {
     let (a, b) = (rank_value(start, contacts), rank_value(end, contacts));
     let better = b < a - 1e-9 * a.abs();

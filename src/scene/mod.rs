@@ -173,8 +173,8 @@ pub struct Stage {
     pub restarts: usize,
     /// IoU at `t` from which a stage no longer restarts (0 to 1).
     pub restart_iou: f64,
-    /// IoU a run must have gained (or the run must have removed a contact) for the
-    /// stage to restart after it (0 to 1).
+    /// IoU a run must have gained for the stage to restart after it (0 to 1); a run that
+    /// started with a contact of the stage's own need only have ranked better.
     pub restart_gain: f64,
     /// How a hold window's instants add up in this stage (default: `hold.objective`).
     pub objective: Option<HoldObjective>,
