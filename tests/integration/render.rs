@@ -340,3 +340,30 @@ fn new_reads_a_json_list_chess_pieces_and_chooses_a_count() {
     let (ok, _, err) = run(args(list.to_str().unwrap()));
     assert!(!ok && err.contains("objects[0].size"), "{err}");
 }
+
+#[test]
+fn new_tries_lower_ceilings_where_the_largest_block_would_span_a_bend() {
+    // On 飞 with its six blocks, the design under the highest ceiling alone stretches a
+    // long block over the stem and its bend (start IoU 0.852); a lower ceiling keeps it
+    // on the straight part and reads better (0.869).
+    let d = tmpdir("new-ceilings");
+    let dir = d.join("fly");
+    let target = root().join("scenes/fly/target.png");
+    let (ok, out, err) = bsa(&[
+        "new",
+        dir.to_str().unwrap(),
+        "--target",
+        target.to_str().unwrap(),
+        "--objects",
+        "box:0.2794x0.06985x0.0349*2,box:0.1397x0.06985x0.0349*4",
+    ]);
+    assert!(ok, "{err}");
+    let iou: f64 = out
+        .split("start guess IoU ")
+        .nth(1)
+        .and_then(|s| s.split(',').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(iou > 0.86, "{out}");
+    assert!(out.contains("no contact before t"), "{out}");
+}
