@@ -252,6 +252,15 @@ fn new_refuses_pictures_objects_and_options_it_cannot_use() {
 }
 
 /// A 160 x 120 picture of two bars (a T), black on white.
+/// The start guess's IoU that `bsa new` printed.
+fn start_iou(out: &str) -> f64 {
+    out.split("start guess IoU ")
+        .nth(1)
+        .and_then(|s| s.split(',').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("{out}"))
+}
+
 fn two_bars(path: &Path) {
     image::GrayImage::from_fn(160, 120, |x, y| {
         let bar = (30..130).contains(&x) && (20..34).contains(&y);
@@ -280,12 +289,7 @@ fn new_lays_blocks_along_strokes_with_two_hints_and_a_contact_free_start() {
     ]);
     assert!(ok, "{err}");
     assert!(out.contains("no contact before t"), "{out}");
-    let iou: f64 = out
-        .split("start guess IoU ")
-        .nth(1)
-        .and_then(|s| s.split(',').next())
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| panic!("{out}"));
+    let iou = start_iou(&out);
     assert!(iou > 0.6, "{out}");
     let scene: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("scene.json")).unwrap()).unwrap();
@@ -358,12 +362,7 @@ fn new_tries_lower_ceilings_where_the_largest_block_would_span_a_bend() {
         "box:0.2794x0.06985x0.0349*2,box:0.1397x0.06985x0.0349*4",
     ]);
     assert!(ok, "{err}");
-    let iou: f64 = out
-        .split("start guess IoU ")
-        .nth(1)
-        .and_then(|s| s.split(',').next())
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| panic!("{out}"));
+    let iou = start_iou(&out);
     assert!(iou > 0.86, "{out}");
     assert!(out.contains("no contact before t"), "{out}");
 }
