@@ -9,7 +9,7 @@ use anyhow::{bail, Context, Result};
 
 use crate::budget::Tolerances;
 use crate::energy::Weights;
-use crate::evaluate::{Problem, Robust};
+use crate::evaluate::{FrameIou, Problem, Robust};
 use crate::optimize::solver::{self, SolveOptions};
 use crate::output::files;
 use crate::output::solution::{self, Solution};
@@ -289,39 +289,23 @@ fn solve_into(
     files::write_solution(&out, &solution)?;
     let mut all = prior;
     all.extend(records);
-    files::write_convergence_plot(&out, &scene.name, &observer.stage_names, &all)?;
-    clock.lap("solution, convergence table and plot");
+    let plot = || files::write_convergence_plot(&out, &scene.name, &observer.stage_names, &all);
+    clock.lap("solution");
     if keep_previous && solution.stages_completed < solution.stages_total {
+        plot()?;
         return Ok(solution);
     }
     // The pictures and exports launch from where the solution does (free positions).
-    let placed;
-    let problem = if problem.plan.free_positions {
-        placed = load::problem_for(scene.clone(), &solution);
-        &placed
-    } else {
-        problem
-    };
-    let mut ws = problem.workspace();
-    let params = solution.parameters();
-    problem.evaluate(&params, &Weights::all_ones(), &mut ws);
-    let title = format!("{}: shadow at t = {} s", scene.name, scene.t);
-    files::write_pictures(&out, &scene.target, &ws.mask, &title)?;
-    files::write_preview(&out, &scene.target, &ws.mask)?;
-    let frame_ious = if scene.single_instant() {
-        Vec::new()
-    } else {
-        problem.frame_ious(&params, &mut ws)
-    };
-    let more = frames::write_pictures(&out, problem, &frame_ious, &mut ws)?;
-    clock.lap("shadow, overlay and preview");
-    let (exported, _) = export::write_exports(
-        &out,
-        problem,
-        &solution,
-        crate::output::trajectory::DEFAULT_MAX_AFTER,
-    )?;
-    clock.lap("exports (motion after t, glb, CSV)");
+    // The plot is drawn on one core while the other draws the pictures and writes the
+    // exports: each takes a hundredth of a second or two, a tenth of a small solve.
+    let placed = placed_problem(problem, &solution);
+    let problem = placed.as_ref().unwrap_or(problem);
+    let (plotted, pictures) = rayon::join(plot, || {
+        write_pictures_and_exports(&out, problem, &solution)
+    });
+    plotted?;
+    let (frame_ious, more, exported) = pictures?;
+    clock.lap("convergence plot beside shadow, overlay, preview and exports");
     let report = crate::output::report::write_report(&out, &solution)?;
     clock.lap("report page");
     println!(
@@ -361,6 +345,45 @@ fn solve_into(
         print_report(&solution, &clock);
     }
     Ok(solution)
+}
+
+/// The problem that launches from the solution's positions, when they were free
+/// variables (`None`: the scene's positions, `problem` itself).
+fn placed_problem(problem: &Problem, solution: &Solution) -> Option<Problem> {
+    problem
+        .plan
+        .free_positions
+        .then(|| load::problem_for(problem.scene.clone(), solution))
+}
+
+/// Write shadow.png, overlay.png, preview.png, the pictures of the later instants and
+/// (with `problem` placed at the solution's launch positions) the exports (glb, launch and trajectory tables). Returns the IoU of each instant, the
+/// extra picture names, and the exports' summary line.
+fn write_pictures_and_exports(
+    out: &Path,
+    problem: &Problem,
+    solution: &Solution,
+) -> Result<(Vec<FrameIou>, Vec<String>, String)> {
+    let scene = &problem.scene;
+    let mut ws = problem.workspace();
+    let params = solution.parameters();
+    problem.evaluate(&params, &Weights::all_ones(), &mut ws);
+    let title = format!("{}: shadow at t = {} s", scene.name, scene.t);
+    files::write_pictures(out, &scene.target, &ws.mask, &title)?;
+    files::write_preview(out, &scene.target, &ws.mask)?;
+    let frame_ious = if scene.single_instant() {
+        Vec::new()
+    } else {
+        problem.frame_ious(&params, &mut ws)
+    };
+    let more = frames::write_pictures(out, problem, &frame_ious, &mut ws)?;
+    let (exported, _) = export::write_exports(
+        out,
+        problem,
+        solution,
+        crate::output::trajectory::DEFAULT_MAX_AFTER,
+    )?;
+    Ok((frame_ious, more, exported))
 }
 
 /// Where the wall time of `bsa solve` went, phase by phase in the order they run.

@@ -195,7 +195,8 @@ fn moments_of_hand_made_masks() {
 #[test]
 fn moments_match_per_pixel_reference() {
     let mut rng = Rng(7);
-    for &(w, h) in &[(64, 3), (130, 40), (640, 20)] {
+    // The last two are past 2^15 pixels a side, where the totals are kept in u128.
+    for &(w, h) in &[(64, 3), (130, 40), (640, 20), (40_000, 3), (2, 33_000)] {
         for density in [5, 50, 95, 100] {
             let m = random_mask(&mut rng, w, h, density);
             let mut r = Moments::default();
