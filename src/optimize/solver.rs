@@ -320,7 +320,10 @@ pub fn solve(
                 &rank,
                 &mut best_params,
                 &mut best_eval,
-                stage.vary.len(),
+                moves::MoveOptions {
+                    max_moves: stage.vary.len(),
+                    polish_single: restart > 0 || stage.vary.len() > 1,
+                },
                 &mut ws,
                 &mut |e: &Evaluation| {
                     records.push(SampleRecord {
@@ -335,7 +338,10 @@ pub fn solve(
             if moved.accepted > 0 {
                 best_mask.copy_from(&ws.mask);
             }
-            let start_from = moved.promising;
+            // A run starts from the promising launch (a better picture with a contact)
+            // only when no move was taken: after a move, the new best is the better
+            // place to refine.
+            let start_from = moved.promising.filter(|_| moved.accepted == 0);
             let from = start_from.as_deref().unwrap_or(&best_params);
             problem.stage_start(from, &stage.vary, &mut x0);
             let config = CmaesConfig {

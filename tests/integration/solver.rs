@@ -311,14 +311,21 @@ fn example_scenes_start_without_contact_near_their_targets() {
     }
 }
 
-/// A planted problem of two spheres (`bsa plant`): its problem and the planted launch.
+/// A planted problem of two spheres (`bsa plant`, radii 0.3 and 0.18 m): its problem
+/// and the planted launch.
 fn planted_pair(name: &str) -> (Problem, Vec<f64>) {
+    planted_spheres(name, "sphere:0.3,sphere:0.18")
+}
+
+/// A planted problem of the spheres `objects` (`bsa plant`): its problem and the planted
+/// launch.
+fn planted_spheres(name: &str, objects: &str) -> (Problem, Vec<f64>) {
     let dir = crate::util::tmpdir(name).join("pair");
     let (ok, _, err) = crate::util::bsa(&[
         "plant",
         dir.to_str().unwrap(),
         "--objects",
-        "sphere:0.3,sphere:0.18",
+        objects,
         "--seed",
         "3",
         "--width",
@@ -377,7 +384,10 @@ fn run_moves(
         rank,
         params,
         &mut best,
-        2,
+        bsa::optimize::moves::MoveOptions {
+            max_moves: 2,
+            polish_single: true,
+        },
         &mut ws,
         &mut |_| {},
     );
@@ -433,4 +443,30 @@ fn moves_swap_two_bodies_that_cover_each_others_parts() {
         "IoU {before} -> {}",
         best.iou
     );
+}
+
+#[test]
+fn swapped_bodies_of_close_sizes_get_the_sizes_of_their_new_parts() {
+    // Two spheres of close sizes, each where the other should be, the smaller one too low
+    // (its shadow too small): a swap at the sizes the parts have now keeps one part too
+    // small, and only the depth polish of the moved bodies finds the planted picture.
+    let (p, planted) = planted_spheres("moves-polish", "sphere:0.3,sphere:0.27");
+    let mut ws = p.workspace();
+    p.evaluate(&planted, &bsa::energy::Weights::all_ones(), &mut ws);
+    let (c0, c1) = (com(&p, &ws, 0), com(&p, &ws, 1));
+    let light = p.scene.camera.light;
+    let mut params = planted.clone();
+    aim(&p, &mut params, 0, c1);
+    aim(&p, &mut params, 1, light + (c0 - light) * 1.12);
+    let rank = |e: &bsa::evaluate::Evaluation| {
+        if e.outcome.own_contact > 0.0 {
+            f64::INFINITY
+        } else {
+            e.total
+        }
+    };
+    let (before, best, _) = run_moves(&p, &mut params, &rank);
+    assert!(before < 0.9, "IoU {before}");
+    assert!(best.iou > 0.97, "IoU {before} -> {}", best.iou);
+    assert_eq!(best.outcome.n_contacts, 0);
 }
