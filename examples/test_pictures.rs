@@ -4,13 +4,16 @@
 //! (DejaVu Sans's airplane, chess knight and umbrella symbols), 640 x 480, black on
 //! white, each with the box of objects it is to be made of, stated before any solve.
 //!
-//! Two sets: set 1 (`tools/test-pictures`), the pictures `bsa new` was developed on, and
+//! Three sets: set 1 (`tools/test-pictures`), the pictures `bsa new` was developed on;
 //! set 2 (`tools/test-pictures-2`), drawn after the code was final and solved once, for
 //! the figures of the issue: letters, digits, outlines, a filled star, a snowman of
-//! discs and two DejaVu symbols (heart and spade) as silhouettes.
+//! discs and two DejaVu symbols (heart and spade) as silhouettes; set 3
+//! (`tools/test-pictures-3`), the same kinds drawn for a later session's final code
+//! (letters F, X, Y, V, U, P, the digit 3, a chevron, a hexagon outline, a house, three
+//! discs, and the club and diamond symbols).
 //!
-//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 or 2, default
-//! 1; DIR default `tools/test-pictures` or `tools/test-pictures-2`): writes
+//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1, 2 or 3,
+//! default 1; DIR default `tools/test-pictures[-SET]`): writes
 //! `DIR/<name>.png` and `DIR/manifest.tsv` (name, objects, extra `bsa new` options),
 //! which `scripts/new-suite.sh` reads. The output depends only on the font file and
 //! this code.
@@ -104,6 +107,103 @@ fn star(x: f64, y: f64) -> bool {
 
 fn snowman(x: f64, y: f64) -> bool {
     x.hypot(y + 100.0) <= 90.0 || x.hypot(y - 40.0) <= 65.0 || x.hypot(y - 140.0) <= 45.0
+}
+
+fn chevron(x: f64, y: f64) -> bool {
+    // A band 60 thick bent to a point down: |x| rises with y along each arm.
+    let d = (y + 120.0 - 0.9 * x.abs()) / 0.9f64.hypot(1.0);
+    x.abs() <= 170.0 && (0.0..=60.0).contains(&d)
+}
+
+fn hexagon(x: f64, y: f64) -> bool {
+    // A hexagonal outline, flat top and bottom, 40 thick.
+    let d = (0..6)
+        .map(|k| {
+            let a = (30.0 + 60.0 * k as f64).to_radians();
+            x * a.cos() + y * a.sin()
+        })
+        .fold(f64::NEG_INFINITY, f64::max);
+    (110.0..=150.0).contains(&d)
+}
+
+fn house(x: f64, y: f64) -> bool {
+    // A filled square with a triangular roof.
+    let body = x.abs() <= 110.0 && (-160.0..=30.0).contains(&y);
+    let roof = y > 30.0 && y <= 30.0 + 130.0 * (1.0 - x.abs() / 150.0);
+    body || roof
+}
+
+fn dots(x: f64, y: f64) -> bool {
+    // Three discs of falling size along a slant.
+    (x + 150.0).hypot(y + 60.0) <= 80.0
+        || (x - 10.0).hypot(y - 20.0) <= 60.0
+        || (x - 140.0).hypot(y - 90.0) <= 45.0
+}
+
+/// Set 3: defined in a later session, run once after that session's code was final,
+/// each with its objects stated before any solve.
+fn pictures_3() -> Vec<(&'static str, Shape, String, &'static str)> {
+    let chess_stage = "--width 0.96 --light-height 3";
+    vec![
+        (
+            "letter-f",
+            Shape::Glyph('F', 6),
+            format!("{DOUBLE},{UNIT}*2"),
+            "",
+        ),
+        ("letter-x", Shape::Glyph('X', 6), format!("{DOUBLE}*2"), ""),
+        (
+            "letter-y",
+            Shape::Glyph('Y', 6),
+            format!("{DOUBLE},{UNIT}*2"),
+            "",
+        ),
+        ("letter-v", Shape::Glyph('V', 6), format!("{DOUBLE}*2"), ""),
+        (
+            "letter-u",
+            Shape::Glyph('U', 6),
+            format!("{DOUBLE}*2,{UNIT}"),
+            "",
+        ),
+        (
+            "digit-3",
+            Shape::Glyph('3', 6),
+            format!("{UNIT}*5,{HALF}*2"),
+            "",
+        ),
+        ("chevron", Shape::Drawn(chevron), format!("{DOUBLE}*2"), ""),
+        ("hexagon", Shape::Drawn(hexagon), format!("{UNIT}*6"), ""),
+        (
+            "house",
+            Shape::Drawn(house),
+            format!("{DOUBLE}*4,{UNIT}*2"),
+            "",
+        ),
+        (
+            "dots",
+            Shape::Drawn(dots),
+            "sphere:0.09,sphere:0.07,sphere:0.05".to_string(),
+            "",
+        ),
+        (
+            "club",
+            Shape::Glyph('\u{2663}', 0),
+            "chess".to_string(),
+            chess_stage,
+        ),
+        (
+            "diamond",
+            Shape::Glyph('\u{2666}', 0),
+            "chess".to_string(),
+            chess_stage,
+        ),
+        (
+            "letter-p",
+            Shape::Glyph('P', 6),
+            format!("{DOUBLE},{UNIT}*3"),
+            "",
+        ),
+    ]
 }
 
 /// Set 2: drawn after the code was final, each with its objects stated before any solve.
@@ -370,7 +470,8 @@ fn main() -> Result<(), Box<dyn Error>> {
     let (list, default_dir) = match set {
         "1" => (pictures(), "tools/test-pictures"),
         "2" => (pictures_2(), "tools/test-pictures-2"),
-        other => return Err(format!("SET must be 1 or 2, got {other:?}").into()),
+        "3" => (pictures_3(), "tools/test-pictures-3"),
+        other => return Err(format!("SET must be 1, 2 or 3, got {other:?}").into()),
     };
     let dir = args
         .get(1)

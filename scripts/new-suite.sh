@@ -6,7 +6,7 @@
 # whole processes). The overlays are tiled into docs/images/new-suite[-auto].png.
 #
 #     bash scripts/new-suite.sh [SEED] [auto]      # defaults: seed 1, the stated boxes
-#     SET=2 bash scripts/new-suite.sh 1             # set 2 (tools/test-pictures-2)
+#     SET=2 bash scripts/new-suite.sh 1             # set 2 (tools/test-pictures-2), or 3
 #
 # With `auto`, every picture gets one automatic item of its kind instead (auto:box of the
 # unit block for the block pictures, auto:sphere for the sphere one, auto:chess for the
@@ -24,7 +24,7 @@ bsa=$bsa/bsa
 set_=${SET:-1}
 pics=tools/test-pictures
 suffix=""
-if [ "$set_" = 2 ]; then pics=tools/test-pictures-2; suffix=-2; fi
+if [ "$set_" != 1 ]; then pics=tools/test-pictures-$set_; suffix=-$set_; fi
 if [ "$mode" = auto ]; then suffix=$suffix-auto; fi
 root=/tmp/bsa-new-suite$suffix
 mkdir -p "$root"

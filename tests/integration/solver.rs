@@ -360,6 +360,15 @@ fn com(p: &Problem, ws: &bsa::evaluate::Workspace, i: usize) -> glam::DVec3 {
     origin + q * p.scene.occluders[i].mass.local_com
 }
 
+/// A rank that puts every sample with a contact of its own after every one without.
+fn contact_free_first(e: &bsa::evaluate::Evaluation) -> f64 {
+    if e.outcome.own_contact > 0.0 {
+        f64::INFINITY
+    } else {
+        e.total
+    }
+}
+
 /// Two rounds of moves of both bodies from `params`, ranked by `rank`: the IoU before,
 /// the evaluation after and the report.
 fn run_moves(
@@ -408,14 +417,7 @@ fn moves_send_a_hidden_body_back_to_the_bare_part_of_the_target() {
     let light = p.scene.camera.light;
     let mut params = planted.clone();
     aim(&p, &mut params, 1, light + (com(&p, &ws, 0) - light) * 1.08);
-    let rank = |e: &bsa::evaluate::Evaluation| {
-        if e.outcome.own_contact > 0.0 {
-            f64::INFINITY
-        } else {
-            e.total
-        }
-    };
-    let (before, best, report) = run_moves(&p, &mut params, &rank);
+    let (before, best, report) = run_moves(&p, &mut params, &contact_free_first);
     assert!(before < 0.9, "IoU {before}");
     assert!(report.accepted >= 1, "{report:?}");
     assert!(
@@ -458,14 +460,7 @@ fn swapped_bodies_of_close_sizes_get_the_sizes_of_their_new_parts() {
     let mut params = planted.clone();
     aim(&p, &mut params, 0, c1);
     aim(&p, &mut params, 1, light + (c0 - light) * 1.12);
-    let rank = |e: &bsa::evaluate::Evaluation| {
-        if e.outcome.own_contact > 0.0 {
-            f64::INFINITY
-        } else {
-            e.total
-        }
-    };
-    let (before, best, _) = run_moves(&p, &mut params, &rank);
+    let (before, best, _) = run_moves(&p, &mut params, &contact_free_first);
     assert!(before < 0.9, "IoU {before}");
     assert!(best.iou > 0.97, "IoU {before} -> {}", best.iou);
     assert_eq!(best.outcome.n_contacts, 0);
