@@ -40,14 +40,16 @@ fn same_seed_gives_bit_identical_solution_with_1_and_2_threads() {
     assert_eq!(params_bits(&a), params_bits(&b));
     assert_eq!(a.total_energy.to_bits(), b.total_energy.to_bits());
     assert_eq!(ra, rb);
-    // A different seed explores differently.
+    // A different seed explores differently: other samples. (The solutions themselves
+    // may coincide on so short a solve: the moves before a run are deterministic, and
+    // twelve iterations may find nothing better than where they left the launch.)
     let opts = SolveOptions {
         threads: Some(2),
         seed: Some(8),
         resume: None,
     };
-    let (c, _) = solver::solve(&p, &opts, &mut solver::Silent, &none);
-    assert_ne!(params_bits(&a), params_bits(&c));
+    let (_, rc) = solver::solve(&p, &opts, &mut solver::Silent, &none);
+    assert_ne!(ra, rc);
 }
 
 /// Raises the interrupt counter twice once the first stage is done: the solve must stop
