@@ -304,7 +304,12 @@ fn solve_into(
         write_pictures_and_exports(&out, problem, &solution)
     });
     plotted?;
-    let (frame_ious, more, exported) = pictures?;
+    let Written {
+        frame_ious,
+        more,
+        exported,
+        outside,
+    } = pictures?;
     clock.lap("convergence plot beside shadow, overlay, preview and exports");
     let report = crate::output::report::write_report(&out, &solution)?;
     clock.lap("report page");
@@ -338,6 +343,20 @@ fn solve_into(
         out.display(),
         more.iter().map(|m| format!(", {m}")).collect::<String>()
     );
+    if !outside.is_empty() {
+        // A shadow beyond the picture costs the solve nothing there, so a body that
+        // fits nowhere may end hidden outside it: say so rather than let the IoU alone
+        // speak (docs/results.md, "Polished moves").
+        let (what, verb) = if outside.len() == 1 {
+            ("shadow", "reaches")
+        } else {
+            ("shadows", "reach")
+        };
+        println!(
+            "note: at t the {what} of {} {verb} beyond the picture; the IoU counts only what falls inside it",
+            outside.join(", ")
+        );
+    }
     frames::print(problem, &frame_ious);
     println!("{exported}");
     println!("report: {}", report.display());
@@ -357,17 +376,22 @@ fn placed_problem(problem: &Problem, solution: &Solution) -> Option<Problem> {
 }
 
 /// Write shadow.png, overlay.png, preview.png, the pictures of the later instants and
-/// (with `problem` placed at the solution's launch positions) the exports (glb, launch and trajectory tables). Returns the IoU of each instant, the
-/// extra picture names, and the exports' summary line.
+/// (with `problem` placed at the solution's launch positions) the exports (glb, launch
+/// and trajectory tables).
 fn write_pictures_and_exports(
     out: &Path,
     problem: &Problem,
     solution: &Solution,
-) -> Result<(Vec<FrameIou>, Vec<String>, String)> {
+) -> Result<Written> {
     let scene = &problem.scene;
     let mut ws = problem.workspace();
     let params = solution.parameters();
     problem.evaluate(&params, &Weights::all_ones(), &mut ws);
+    let outside = if scene.single_instant() {
+        outside_names(problem, &ws)
+    } else {
+        Vec::new()
+    };
     let title = format!("{}: shadow at t = {} s", scene.name, scene.t);
     files::write_pictures(out, &scene.target, &ws.mask, &title)?;
     files::write_preview(out, &scene.target, &ws.mask)?;
@@ -383,7 +407,36 @@ fn write_pictures_and_exports(
         solution,
         crate::output::trajectory::DEFAULT_MAX_AFTER,
     )?;
-    Ok((frame_ious, more, exported))
+    Ok(Written {
+        frame_ious,
+        more,
+        exported,
+        outside,
+    })
+}
+
+/// What [`write_pictures_and_exports`] wrote and found.
+struct Written {
+    /// The IoU of each instant (empty for a single instant).
+    frame_ious: Vec<FrameIou>,
+    /// The names of the extra pictures.
+    more: Vec<String>,
+    /// The exports' summary line.
+    exported: String,
+    /// The occluders whose shadows at `t` reach beyond the picture (single instant only).
+    outside: Vec<String>,
+}
+
+/// The names of the occluders whose shadows reach beyond the picture, for the poses of
+/// the last evaluation on `ws`.
+fn outside_names(problem: &Problem, ws: &crate::evaluate::Workspace) -> Vec<String> {
+    problem
+        .shadows_in_image(ws)
+        .iter()
+        .zip(&problem.scene.occluders)
+        .filter(|(inside, _)| !**inside)
+        .map(|(_, o)| o.name.clone())
+        .collect()
 }
 
 /// Where the wall time of `bsa solve` went, phase by phase in the order they run.

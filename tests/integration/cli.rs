@@ -19,6 +19,40 @@ fn check_accepts_mickey() {
 }
 
 #[test]
+fn solve_says_when_a_shadow_reaches_beyond_the_picture() {
+    // A fourth ball that stays on the table far to the side: its shadow lies outside the
+    // picture, where it costs nothing, and the solve says so by name.
+    let d = variant("cli-outside", |v| {
+        v["occluders"]
+            .as_array_mut()
+            .unwrap()
+            .push(serde_json::json!({
+                "name": "aside", "shape": { "sphere": { "radius": 0.3 } },
+                "position": [3.5, 0.0, 0.3], "mass": 1.0, "launched": false
+            }));
+        for s in v["stages"].as_array_mut().unwrap() {
+            s["max_iterations"] = 3.into();
+            s["population"] = 8.into();
+        }
+    });
+    let out = d.join("out");
+    let (ok, stdout, err) = bsa(&[
+        "solve",
+        d.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(ok, "{err}");
+    let note = stdout
+        .lines()
+        .find(|l| l.starts_with("note: at t the shadow"))
+        .unwrap_or_else(|| panic!("no note: {stdout}"));
+    assert!(note.contains("aside"), "{note}");
+    assert!(!note.contains("head"), "{note}");
+}
+
+#[test]
 fn solve_and_eval_from_the_command_line() {
     // A short run of the real command (few iterations) writes every output file, and
     // `eval` reads the solution back.
