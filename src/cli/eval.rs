@@ -75,13 +75,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         let b = j.map_or_else(|| "table".to_string(), |j| scene.occluders[j].name.clone());
         (a, b)
     });
-    let outside: Vec<&str> = problem
-        .shadows_in_image(&ws)
-        .iter()
-        .zip(&scene.occluders)
-        .filter(|(inside, _)| !**inside)
-        .map(|(_, o)| o.name.as_str())
-        .collect();
+    let outside = super::frames::outside_names(&problem, &ws);
     let frame_ious = if scene.single_instant() {
         Vec::new()
     } else {

@@ -1,6 +1,6 @@
 //! The pictures and tables of a scene with several instants (`targets`, `hold`), shared
 //! by `solve`, `render` and `eval`: the IoU at every frame, an overlay per picture and
-//! one of the hold window's worst frame.
+//! one of the hold window's worst frame; and the shadows that reach beyond the picture.
 
 use std::path::Path;
 
@@ -8,6 +8,18 @@ use anyhow::Result;
 
 use crate::evaluate::{FrameIou, Problem, Workspace};
 use crate::output::files;
+
+/// The names of the occluders whose shadows reach beyond the picture, for the poses of
+/// the last evaluation on `ws` (`solve`'s note, `eval`'s line).
+pub(super) fn outside_names(problem: &Problem, ws: &Workspace) -> Vec<String> {
+    problem
+        .shadows_in_image(ws)
+        .iter()
+        .zip(&problem.scene.occluders)
+        .filter(|(inside, _)| !**inside)
+        .map(|(_, o)| o.name.clone())
+        .collect()
+}
 
 /// The frame with the lowest IoU (the first of equals).
 pub(super) fn worst(frames: &[FrameIou]) -> Option<FrameIou> {

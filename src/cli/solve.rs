@@ -388,7 +388,7 @@ fn write_pictures_and_exports(
     let params = solution.parameters();
     problem.evaluate(&params, &Weights::all_ones(), &mut ws);
     let outside = if scene.single_instant() {
-        outside_names(problem, &ws)
+        frames::outside_names(problem, &ws)
     } else {
         Vec::new()
     };
@@ -425,18 +425,6 @@ struct Written {
     exported: String,
     /// The occluders whose shadows at `t` reach beyond the picture (single instant only).
     outside: Vec<String>,
-}
-
-/// The names of the occluders whose shadows reach beyond the picture, for the poses of
-/// the last evaluation on `ws`.
-fn outside_names(problem: &Problem, ws: &crate::evaluate::Workspace) -> Vec<String> {
-    problem
-        .shadows_in_image(ws)
-        .iter()
-        .zip(&problem.scene.occluders)
-        .filter(|(inside, _)| !**inside)
-        .map(|(_, o)| o.name.clone())
-        .collect()
 }
 
 /// Where the wall time of `bsa solve` went, phase by phase in the order they run.

@@ -121,11 +121,11 @@ impl Search<'_> {
     }
 
     /// Slide each body a move moved (`candidate`, evaluated as `best`) along its line of
-    /// sight from the light, one step size after the other, keeping a change when it makes a better
-    /// picture (the energy without contacts: the slide looks for the size of the new
-    /// part, and a contact on the way there often goes at the right size; the caller
-    /// ranks the result with its contacts). `candidate` ends as the best launch found;
-    /// returns its evaluation.
+    /// sight from the light, one step size after the other, keeping a change when it
+    /// makes a better picture (the energy without contacts: the slide looks for the size
+    /// of the new part, and a contact on the way there often goes at the right size; the
+    /// caller ranks the result with its contacts). `candidate` ends as the best launch
+    /// found; returns its evaluation.
     fn polish(
         &mut self,
         candidate: &mut [f64],
@@ -359,12 +359,10 @@ fn send(
     area: f64,
 ) {
     let scene = &problem.scene;
-    let o = &scene.occluders[i];
     let light = scene.camera.light;
     let mut depth = own.depth * (own.area / area).sqrt();
     // Keep the body's lowest point above the table (for a level table under the light).
-    if let Some(table) = &scene.table {
-        let top = table.top() + o.bounding_radius + TABLE_CLEARANCE;
+    if let Some(top) = lowest_centre(problem, i) {
         let drop = light.z - on_receiver.z;
         if drop > 0.0 && light.z > top {
             depth = depth.min((light.z - top) / drop);
@@ -401,11 +399,17 @@ fn slide(problem: &Problem, params: &mut [f64], i: usize, factor: f64) -> bool {
         return false;
     }
     let target = light + (com - light) * factor;
-    if let Some(table) = &scene.table {
-        if target.z - o.bounding_radius - TABLE_CLEARANCE < table.top() {
-            return false;
-        }
+    if lowest_centre(problem, i).is_some_and(|top| target.z < top) {
+        return false;
     }
     aim(problem, params, i, target);
     true
+}
+
+/// The lowest height a moved body's centre of mass may take at `t`: its bounding sphere
+/// and [`TABLE_CLEARANCE`] above the table top (`None` without a table).
+fn lowest_centre(problem: &Problem, i: usize) -> Option<f64> {
+    let o = &problem.scene.occluders[i];
+    let table = problem.scene.table.as_ref()?;
+    Some(table.top() + o.bounding_radius + TABLE_CLEARANCE)
 }

@@ -18,6 +18,14 @@ fn check_accepts_mickey() {
     );
 }
 
+/// Cut every stage of a scene's JSON to `iterations` of `population` samples.
+fn short_stages(v: &mut serde_json::Value, iterations: usize, population: usize) {
+    for s in v["stages"].as_array_mut().unwrap() {
+        s["max_iterations"] = iterations.into();
+        s["population"] = population.into();
+    }
+}
+
 #[test]
 fn solve_says_when_a_shadow_reaches_beyond_the_picture() {
     // A fourth ball that stays on the table far to the side: its shadow lies outside the
@@ -30,10 +38,7 @@ fn solve_says_when_a_shadow_reaches_beyond_the_picture() {
                 "name": "aside", "shape": { "sphere": { "radius": 0.3 } },
                 "position": [3.5, 0.0, 0.3], "mass": 1.0, "launched": false
             }));
-        for s in v["stages"].as_array_mut().unwrap() {
-            s["max_iterations"] = 3.into();
-            s["population"] = 8.into();
-        }
+        short_stages(v, 3, 8);
     });
     let out = d.join("out");
     let (ok, stdout, err) = bsa(&[
@@ -56,12 +61,7 @@ fn solve_says_when_a_shadow_reaches_beyond_the_picture() {
 fn solve_and_eval_from_the_command_line() {
     // A short run of the real command (few iterations) writes every output file, and
     // `eval` reads the solution back.
-    let d = variant("cli", |v| {
-        for s in v["stages"].as_array_mut().unwrap() {
-            s["max_iterations"] = 5.into();
-            s["population"] = 12.into();
-        }
-    });
+    let d = variant("cli", |v| short_stages(v, 5, 12));
     let out = d.join("out");
     let (ok, stdout, err) = bsa(&[
         "solve",
@@ -298,10 +298,7 @@ fn copied_scene_with_the_original_name_never_touches_the_originals_results() {
     // the JSON name `mickey` but has another t (the trap of issue #15).
     let base = tmpdir("trap");
     let src = variant("trap-src", |v| {
-        for s in v["stages"].as_array_mut().unwrap() {
-            s["max_iterations"] = 3.into();
-            s["population"] = 8.into();
-        }
+        short_stages(v, 3, 8);
     });
     let copy_scene = |folder: &str, t: Option<f64>| {
         let d = base.join(folder);
