@@ -219,18 +219,30 @@ fn farthest_pixel(mask: &Mask, cx: f64, cy: f64) -> f64 {
 }
 
 impl TargetData {
+    /// The target data of a picture drawn on a canvas of its own size.
     pub fn new(mask: &Mask) -> TargetData {
+        TargetData::on_canvas(mask, 0)
+    }
+
+    /// The target data of `picture` on the solver's canvas, `margin` pixels larger on
+    /// every side (see [`crate::evaluate::Problem`]): the masks and moments are the
+    /// padded ones, in canvas pixels, so that shadow beyond the picture counts as shadow
+    /// where the target has none. The barrier and hint geometry (`center`,
+    /// `barrier_radius`, `diagonal`) stay in the picture's own pixels, where hints are
+    /// projected.
+    pub fn on_canvas(picture: &Mask, margin: usize) -> TargetData {
+        let (w, h) = (picture.width() as f64, picture.height() as f64);
+        let mask = picture.padded(margin);
         let inner = mask.and_not(&mask.erode(BOUNDARY_KERNEL));
-        let outer = mask.dilate(BOUNDARY_KERNEL).and_not(mask);
-        let (w, h) = (mask.width() as f64, mask.height() as f64);
+        let outer = mask.dilate(BOUNDARY_KERNEL).and_not(&mask);
         TargetData {
-            mask: mask.clone(),
+            moments: mask.moments(),
+            mask,
             inner,
             outer,
-            moments: mask.moments(),
             diagonal: (w * w + h * h).sqrt(),
             center: DVec2::new(w / 2.0, h / 2.0),
-            barrier_radius: (h / 2.0).max(farthest_pixel(mask, w / 2.0, h / 2.0)),
+            barrier_radius: (h / 2.0).max(farthest_pixel(picture, w / 2.0, h / 2.0)),
         }
     }
 

@@ -44,9 +44,10 @@ pub(super) fn write_pictures(
     if scene.pictures.len() > 1 {
         for (k, pic) in scene.pictures.iter().enumerate() {
             problem.shadow_at(pic.t, ws);
+            let picture = problem.picture_of(&ws.mask);
             let img =
-                crate::output::picture::mask_image(ws.mask.width(), ws.mask.height(), &|x, y| {
-                    ws.mask.get(x, y)
+                crate::output::picture::mask_image(picture.width(), picture.height(), &|x, y| {
+                    picture.get(x, y)
                 });
             let (shadow, overlay) = (
                 format!("shadow_{}.png", k + 1),
@@ -54,7 +55,7 @@ pub(super) fn write_pictures(
             );
             files::save_png(&img, &dir.join(&shadow))?;
             let title = format!("{}: picture {} at t = {} s", scene.name, k + 1, pic.t);
-            files::save_overlay(&dir.join(&overlay), &pic.target, &ws.mask, &title)?;
+            files::save_overlay(&dir.join(&overlay), &pic.target, &picture, &title)?;
             written.extend([shadow, overlay]);
         }
     }
@@ -70,7 +71,7 @@ pub(super) fn write_pictures(
         files::save_overlay(
             &dir.join("overlay_worst.png"),
             &pic.target,
-            &ws.mask,
+            &problem.picture_of(&ws.mask),
             &title,
         )?;
         written.push("overlay_worst.png".into());

@@ -287,7 +287,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     files::save_overlay(
         &dir.join("start.png"),
         &problem.scene.target,
-        &ws.mask,
+        &problem.picture_of(&ws.mask),
         &format!("{name}: the start guess at t, before any solve"),
     )?;
     let n = plan.objects.len();

@@ -111,7 +111,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let params = plant::draw_launch(&problem, opts.seed, ATTEMPTS)?;
     let mut ws = problem.workspace();
     problem.evaluate(&params, &Weights::default(), &mut ws);
-    let target = ws.mask.clone();
+    let target = problem.picture_of(&ws.mask);
     write_target(dir, &target)?;
     let hints = plant::hints(&problem, &target);
     write_scene(&hints)?;

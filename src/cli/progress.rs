@@ -9,6 +9,7 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use crate::evaluate::canvas_margin;
 use crate::optimize::solver::{IterationInfo, Observer};
 use crate::output::files;
 use crate::output::solution::{SampleRecord, Solution};
@@ -74,7 +75,12 @@ impl SolveProgress {
     ) -> anyhow::Result<SolveProgress> {
         let csv = files::ConvergenceCsv::create(&out, prior)?;
         Ok(SolveProgress {
-            writer: Writer::start(out, scene.target.clone(), csv),
+            writer: Writer::start(
+                out,
+                scene.target.clone(),
+                canvas_margin(scene.target.width(), scene.target.height()),
+                csv,
+            ),
             stage_names: scene.stages.iter().map(|s| s.name.clone()).collect(),
             encoded: 0,
             run_length: 0,
@@ -204,7 +210,8 @@ struct Writer {
 }
 
 impl Writer {
-    fn start(out: PathBuf, target: Mask, csv: files::ConvergenceCsv) -> Writer {
+    /// `margin`: the canvas's margin around the picture in the previews' masks.
+    fn start(out: PathBuf, target: Mask, margin: usize, csv: files::ConvergenceCsv) -> Writer {
         let (jobs, queue) = mpsc::channel::<Job>();
         let preview_pending = Arc::new(AtomicBool::new(false));
         let pending = Arc::clone(&preview_pending);
@@ -222,7 +229,7 @@ impl Writer {
                         .and_then(|_| files::write_solution(&out, &solution)),
                     (None, Job::Rows(rows)) => csv.append(&rows),
                     (None, Job::Preview(mask)) => {
-                        let r = files::write_preview(&out, &target, &mask);
+                        let r = files::write_preview(&out, &target, &mask.cropped(margin));
                         pending.store(false, Ordering::SeqCst);
                         r
                     }

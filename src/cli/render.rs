@@ -74,14 +74,16 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let e = problem.evaluate(&params, &Weights::all_ones(), &mut ws);
     let mut iou = energy::iou(&ws.mask, &problem.target.mask);
     // The picture an instant is scored against: the one whose instant is nearest.
-    let picture = scene
-        .pictures
-        .iter()
-        .min_by(|a, b| (a.t - at).abs().total_cmp(&(b.t - at).abs()))
+    let k = (0..scene.pictures.len())
+        .min_by(|&a, &b| {
+            let d = |k: usize| (scene.pictures[k].t - at).abs();
+            d(a).total_cmp(&d(b))
+        })
         .expect("a scene has a picture");
+    let picture = &scene.pictures[k];
     if at != scene.t {
         problem.shadow_at(at, &mut ws);
-        iou = energy::iou(&ws.mask, &picture.target);
+        iou = energy::iou(&ws.mask, &problem.pictures[k].mask);
     }
     std::fs::create_dir_all(&opts.out)
         .with_context(|| format!("cannot create {}", opts.out.display()))?;
@@ -91,7 +93,12 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         at,
         opts.solution.display()
     );
-    files::write_pictures(&opts.out, &picture.target, &ws.mask, &title)?;
+    files::write_pictures(
+        &opts.out,
+        &picture.target,
+        &problem.picture_of(&ws.mask),
+        &title,
+    )?;
     let mut more = Vec::new();
     let frame_ious = if scene.single_instant() {
         Vec::new()

@@ -344,17 +344,18 @@ fn solve_into(
         more.iter().map(|m| format!(", {m}")).collect::<String>()
     );
     if !outside.is_empty() {
-        // A shadow beyond the picture costs the solve nothing there, so a body that
-        // fits nowhere may end hidden outside it: say so rather than let the IoU alone
-        // speak (docs/results.md, "Polished moves").
+        // A shadow beyond the picture counts as extra shadow up to the canvas's margin
+        // and costs nothing farther out: a body that fits nowhere may end out there.
+        // Say so rather than let the IoU alone speak.
         let (what, verb) = if outside.len() == 1 {
             ("shadow", "reaches")
         } else {
             ("shadows", "reach")
         };
         println!(
-            "note: at t the {what} of {} {verb} beyond the picture; the IoU counts only what falls inside it",
-            outside.join(", ")
+            "note: at t the {what} of {} {verb} beyond the picture; the IoU counts the part beyond it as extra shadow, up to {} px from its edges",
+            outside.join(", "),
+            problem.margin
         );
     }
     frames::print(problem, &frame_ious);
@@ -393,8 +394,9 @@ fn write_pictures_and_exports(
         Vec::new()
     };
     let title = format!("{}: shadow at t = {} s", scene.name, scene.t);
-    files::write_pictures(out, &scene.target, &ws.mask, &title)?;
-    files::write_preview(out, &scene.target, &ws.mask)?;
+    let shadow = problem.picture_of(&ws.mask);
+    files::write_pictures(out, &scene.target, &shadow, &title)?;
+    files::write_preview(out, &scene.target, &shadow)?;
     let frame_ious = if scene.single_instant() {
         Vec::new()
     } else {

@@ -31,7 +31,7 @@ use crate::geometry::distance::{table_shape, ContactShape};
 use crate::geometry::shape::Shape;
 use crate::scene::{Launch, Scene};
 use crate::shadow::mask::Mask;
-use crate::shadow::raster::{ClosedMesh, MeshSilhouette, RasterScratch};
+use crate::shadow::raster::{ClosedMesh, MeshSilhouette, RasterScratch, ShadowCamera};
 use crate::sim::contact::{self, Body, Motion};
 use crate::sim::flight::{FlightConfig, FreeFlight};
 
@@ -60,10 +60,29 @@ pub const PROFILE_PHASES: [&str; 11] = [
 /// Contacts closer together in time than this (s) are counted as one event's contacts.
 const SIMULTANEOUS: f64 = 1e-6;
 
+/// How far the canvas reaches beyond each edge of the picture, as a fraction of the
+/// picture's longer side.
+pub const CANVAS_MARGIN: f64 = 0.25;
+
+/// The margin (pixels, on every side) of the canvas of a `width` x `height` picture.
+pub fn canvas_margin(width: usize, height: usize) -> usize {
+    (CANVAS_MARGIN * width.max(height) as f64).ceil() as usize
+}
+
 /// A scene plus everything the hot loop derives from it once.
+///
+/// Shadows are drawn on a canvas larger than the picture by [`canvas_margin`] on every
+/// side, and the targets are padded to it: a shadow beyond the picture's edge then counts
+/// as shadow where the target has none (in XOR, the moments, the IoU) instead of costing
+/// nothing, which had let the solver hide a body it could not place. Every mask a
+/// [`Workspace`] holds is a canvas mask; [`Problem::picture_of`] cuts the picture out.
 pub struct Problem {
     pub scene: Scene,
-    /// The target of the scene's `t` (the last picture).
+    /// The shadow camera of the canvas: `scene.camera` widened by `margin`.
+    pub canvas: ShadowCamera,
+    /// Pixels of canvas beyond each edge of the picture.
+    pub margin: usize,
+    /// The target of the scene's `t` (the last picture), on the canvas.
     pub target: TargetData,
     /// Every picture's target, as `scene.pictures`.
     pub pictures: Vec<TargetData>,
@@ -268,14 +287,16 @@ impl Problem {
     }
 
     pub fn new(scene: Scene) -> Problem {
-        let target = TargetData::new(&scene.target);
+        let margin = canvas_margin(scene.target.width(), scene.target.height());
+        let canvas = scene.camera.widened(margin);
+        let target = TargetData::on_canvas(&scene.target, margin);
         let pictures = if scene.pictures.len() == 1 {
             vec![target.clone()]
         } else {
             scene
                 .pictures
                 .iter()
-                .map(|p| TargetData::new(&p.target))
+                .map(|p| TargetData::on_canvas(&p.target, margin))
                 .collect()
         };
         let plan = Plan::of(&scene);
@@ -304,6 +325,8 @@ impl Problem {
             .collect();
         Problem {
             scene,
+            canvas,
+            margin,
             target,
             pictures,
             plan,
@@ -313,6 +336,11 @@ impl Problem {
             silhouettes,
             flight: FlightConfig::default(),
         }
+    }
+
+    /// The picture's part of a canvas mask (a shadow drawn by this problem).
+    pub fn picture_of(&self, canvas_mask: &Mask) -> Mask {
+        canvas_mask.cropped(self.margin)
     }
 
     /// A fresh workspace for one worker thread.
@@ -330,7 +358,7 @@ impl Problem {
             .unwrap_or(8);
         Workspace {
             flights: (0..n).map(|_| FreeFlight::default()).collect(),
-            mask: Mask::new(self.scene.target.width(), self.scene.target.height()),
+            mask: Mask::new(self.canvas.width_px, self.canvas.height_px),
             raster: RasterScratch::default(),
             world_vertices: Vec::with_capacity(max_vertices),
             poses: vec![(DVec3::ZERO, DQuat::IDENTITY); n],
@@ -652,7 +680,7 @@ impl Problem {
     /// [`Problem::shadow`] of the occluders in `which` only, drawn over `start` (a held
     /// shadow; OR is order-free, so the mask is the same as drawing everything).
     fn shadow_with(&self, start: Option<&Mask>, which: Option<&[bool]>, ws: &mut Workspace) {
-        let cam = &self.scene.camera;
+        let cam = &self.canvas;
         match start {
             Some(m) => ws.mask.copy_from(m),
             None => ws.mask.clear(),

@@ -153,6 +153,43 @@ fn shadows_in_image_tells_a_shadow_cut_by_the_image_edge() {
     }
 }
 
+/// A shadow across the picture's edge counts beyond it as extra shadow, in XOR and in
+/// the IoU: before the canvas, the part beyond cost nothing, and solves hid bodies there.
+#[test]
+fn a_shadow_beyond_the_picture_counts_as_extra_shadow() {
+    for name in ["mickey", "thinker"] {
+        let p = scene(name);
+        let mut ws = p.workspace();
+        p.evaluate(&p.scene.start_parameters(), &Weights::all_ones(), &mut ws);
+        for pose in ws.poses.iter_mut() {
+            *pose = (DVec3::new(0.0, 0.0, 1.0), DQuat::IDENTITY);
+        }
+        let cam = &p.scene.camera;
+        let edge = cam.pixel_to_world(cam.width_px as f64, 0.5 * cam.height_px as f64);
+        ws.poses[0].0 = edge * (1.0 - 1.0 / cam.light_height()) + DVec3::new(0.0, 0.0, 1.0);
+        p.shadow(&mut ws);
+        let picture = p.picture_of(&ws.mask);
+        assert_eq!(
+            (picture.width(), picture.height()),
+            (p.scene.target.width(), p.scene.target.height())
+        );
+        let beyond = ws.mask.count() - picture.count();
+        assert!(
+            beyond > 0,
+            "{name}: part of the shadow lies beyond the edge"
+        );
+        let mut raw = [0.0; TERM_COUNT];
+        energy::image_terms(&p.target, &ws.mask, &Weights::all_ones(), &mut raw);
+        let inside = picture.xor_count(&p.scene.target);
+        assert_eq!(raw[Term::Xor as usize], (inside + beyond) as f64, "{name}");
+        let canvas_iou = energy::iou(&ws.mask, &p.target.mask);
+        assert!(
+            canvas_iou < energy::iou(&picture, &p.scene.target),
+            "{name}"
+        );
+    }
+}
+
 /// Mickey with its scene edited by `edit` (pictures, hold, positions), rebuilt.
 fn mickey_with(edit: impl FnOnce(&mut crate::scene::Scene)) -> Problem {
     let mut s = scene("mickey").scene;

@@ -75,7 +75,8 @@ pub fn compare_at(problem: &Problem, params: &[f64], time: f64, cycles: &Mask) -
     if time != problem.scene.t {
         problem.shadow_at(time, &mut ws);
     }
-    let ours = &ws.mask;
+    // Cycles renders the picture only; the solver's canvas reaches beyond it.
+    let ours = &problem.picture_of(&ws.mask);
     let difference = picture::difference_image(
         cycles.width(),
         cycles.height(),

@@ -29,7 +29,7 @@ fn short_stages(v: &mut serde_json::Value, iterations: usize, population: usize)
 #[test]
 fn solve_says_when_a_shadow_reaches_beyond_the_picture() {
     // A fourth ball that stays on the table far to the side: its shadow lies outside the
-    // picture, where it costs nothing, and the solve says so by name.
+    // picture, and the solve says so by name.
     let d = variant("cli-outside", |v| {
         v["occluders"]
             .as_array_mut()

@@ -163,9 +163,9 @@ fn golden_shadow_of_a_fixed_launch() {
     let mut ws = p.workspace();
     p.evaluate(&params, &bsa::energy::Weights::all_ones(), &mut ws);
     let golden = root().join("tests/golden/mickey_fixed_launch.png");
-    let now = bsa::output::picture::mask_image(ws.mask.width(), ws.mask.height(), &|x, y| {
-        ws.mask.get(x, y)
-    });
+    let shadow = p.picture_of(&ws.mask);
+    let now =
+        bsa::output::picture::mask_image(shadow.width(), shadow.height(), &|x, y| shadow.get(x, y));
     if std::env::var_os("BSA_UPDATE_GOLDEN").is_some() {
         std::fs::create_dir_all(golden.parent().unwrap()).unwrap();
         now.save(&golden).unwrap();

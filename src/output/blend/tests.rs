@@ -14,7 +14,7 @@ fn planted(name: &str) -> (Problem, Track) {
     let params = p.start_parameters();
     let mut ws = p.workspace();
     p.evaluate(&params, &Weights::all_ones(), &mut ws);
-    scene.target = ws.mask.clone();
+    scene.target = p.picture_of(&ws.mask);
     let p = Problem::new(scene);
     let track = trajectory::track(&p, &params, DEFAULT_MAX_AFTER);
     (p, track)

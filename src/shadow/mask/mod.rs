@@ -191,6 +191,46 @@ impl Mask {
         out
     }
 
+    /// The set pixels of `self` 4-connected (within `self`) to a pixel set in both
+    /// `self` and `seed` (same size): the parts of `self` that `seed` touches.
+    pub fn connected_to(&self, seed: &Mask) -> Mask {
+        assert!(
+            self.width == seed.width && self.height == seed.height,
+            "mask sizes differ"
+        );
+        let (w, h) = (self.width, self.height);
+        let mut out = Mask::new(w, h);
+        let mut stack = Vec::new();
+        for y in seed.rows.clone() {
+            for (k, (&a, &b)) in self.row(y).iter().zip(seed.row(y)).enumerate() {
+                let mut both = a & b;
+                while both != 0 {
+                    let x = 64 * k + both.trailing_zeros() as usize;
+                    both &= both - 1;
+                    if !out.get(x, y) {
+                        out.set(x, y);
+                        stack.push((x, y));
+                    }
+                }
+            }
+        }
+        while let Some((x, y)) = stack.pop() {
+            let near = [
+                (x.wrapping_sub(1), y),
+                (x + 1, y),
+                (x, y.wrapping_sub(1)),
+                (x, y + 1),
+            ];
+            for (nx, ny) in near {
+                if nx < w && ny < h && self.get(nx, ny) && !out.get(nx, ny) {
+                    out.set(nx, ny);
+                    stack.push((nx, ny));
+                }
+            }
+        }
+        out
+    }
+
     /// A mask with pixel `(x, y)` set iff `f(x, y)`.
     pub fn from_fn(width: usize, height: usize, mut f: impl FnMut(usize, usize) -> bool) -> Mask {
         let mut m = Mask::new(width, height);
@@ -202,6 +242,45 @@ impl Mask {
             }
         }
         m
+    }
+
+    /// This mask with `margin` empty pixels added on every side: the picture on the
+    /// solver's canvas ([`crate::evaluate::Problem`] draws shadows there, so that a shadow
+    /// beyond the picture's edge still counts).
+    pub fn padded(&self, margin: usize) -> Mask {
+        let mut out = Mask::new(self.width + 2 * margin, self.height + 2 * margin);
+        for y in self.rows.clone() {
+            for x in 0..self.width {
+                if self.get(x, y) {
+                    out.set(x + margin, y + margin);
+                }
+            }
+        }
+        out
+    }
+
+    /// The inside of this mask without `margin` pixels on every side: the inverse of
+    /// [`Mask::padded`], the picture cut out of the canvas.
+    pub fn cropped(&self, margin: usize) -> Mask {
+        assert!(
+            2 * margin <= self.width && 2 * margin <= self.height,
+            "a margin of {margin} pixels does not fit a {}x{} mask",
+            self.width,
+            self.height
+        );
+        let (w, h) = (self.width - 2 * margin, self.height - 2 * margin);
+        let mut out = Mask::new(w, h);
+        for y in self.rows.clone() {
+            if y < margin || y >= margin + h {
+                continue;
+            }
+            for x in 0..w {
+                if self.get(x + margin, y) {
+                    out.set(x, y - margin);
+                }
+            }
+        }
+        out
     }
 
     pub fn width(&self) -> usize {
@@ -411,6 +490,19 @@ impl Mask {
         let mut out = self.clone();
         for (o, b) in out.words.iter_mut().zip(&other.words) {
             *o &= !b;
+        }
+        out
+    }
+
+    /// `self & other` as a new mask.
+    pub fn and(&self, other: &Mask) -> Mask {
+        assert!(
+            self.width == other.width && self.height == other.height,
+            "mask sizes differ"
+        );
+        let mut out = self.clone();
+        for (o, b) in out.words.iter_mut().zip(&other.words) {
+            *o &= b;
         }
         out
     }

@@ -294,3 +294,44 @@ fn dilate_and_erode_match_reference() {
         }
     }
 }
+
+#[test]
+fn padded_then_cropped_is_the_same_mask() {
+    let mut rng = Rng(41);
+    for (w, h, m) in [(70, 50, 18), (64, 64, 16), (130, 9, 33), (5, 3, 0)] {
+        let a = random_mask(&mut rng, w, h, 30);
+        let p = a.padded(m);
+        assert_eq!((p.width(), p.height()), (w + 2 * m, h + 2 * m));
+        assert_eq!(p.count(), a.count());
+        assert!(padding_is_zero(&p));
+        for y in 0..h {
+            for x in 0..w {
+                assert_eq!(p.get(x + m, y + m), a.get(x, y));
+            }
+        }
+        assert_eq!(p.cropped(m), a);
+        // Pixels in the margin are cut off.
+        let mut q = p.clone();
+        if m > 0 {
+            q.set(0, 0);
+            q.set(w + 2 * m - 1, h + m);
+        }
+        assert_eq!(q.cropped(m), a);
+    }
+}
+
+#[test]
+fn connected_to_keeps_the_components_a_seed_touches() {
+    // Three bars: the seed touches the first and the third, through one pixel each.
+    let m = Mask::from_fn(150, 40, |x, y| {
+        (y == 3 && x < 120) || (x == 70 && (10..30).contains(&y)) || (y == 35 && x >= 60)
+    });
+    let seed = Mask::from_fn(150, 40, |x, y| {
+        (x, y) == (5, 3) || (x, y) == (149, 35) || (x, y) == (0, 0)
+    });
+    let got = m.connected_to(&seed);
+    let want = Mask::from_fn(150, 40, |x, y| (y == 3 && x < 120) || (y == 35 && x >= 60));
+    assert_eq!(got, want);
+    assert_eq!(m.connected_to(&Mask::new(150, 40)).count(), 0);
+    assert_eq!(m.and(&seed).count(), 2);
+}

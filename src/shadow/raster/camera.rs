@@ -129,6 +129,26 @@ impl ShadowCamera {
         }
     }
 
+    /// The same camera over a larger rectangle: `margin` more pixels of the same size on
+    /// every side, so pixel `(x, y)` of this camera is pixel `(x + margin, y + margin)` of
+    /// the widened one.
+    pub fn widened(&self, margin: usize) -> ShadowCamera {
+        let (wp, hp) = (self.width_px as f64, self.height_px as f64);
+        let m = margin as f64;
+        ShadowCamera::new(
+            self.light,
+            ImageRect {
+                center: self.center,
+                u: self.u,
+                v: self.v,
+                width_m: self.width_m * (wp + 2.0 * m) / wp,
+                height_m: self.height_m * (hp + 2.0 * m) / hp,
+                width_px: self.width_px + 2 * margin,
+                height_px: self.height_px + 2 * margin,
+            },
+        )
+    }
+
     /// Unit normal of the receiver plane, pointing to the light's side.
     pub fn normal(&self) -> DVec3 {
         self.n

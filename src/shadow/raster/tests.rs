@@ -189,6 +189,33 @@ fn project_and_pixel_to_world_round_trip() {
     assert_eq!(cam.light_height(), 6.0);
 }
 
+#[test]
+fn a_widened_camera_draws_the_same_pixels_shifted_by_its_margin() {
+    let mut rng = Rng(12);
+    for _ in 0..10 {
+        let (cam, _) = random_camera(&mut rng, 320, 240);
+        let m = 80;
+        let wide = cam.widened(m);
+        assert_eq!((wide.width_px, wide.height_px), (480, 400));
+        for (px, py) in [(0.0, 0.0), (320.0, 240.0), (-80.0, 17.5), (133.25, 250.0)] {
+            let a = cam.pixel_to_world(px, py);
+            let b = wide.pixel_to_world(px + m as f64, py + m as f64);
+            assert!(a.distance(b) < 1e-9, "{a} vs {b}");
+        }
+        // A ball whose shadow crosses the picture's left edge: the same pixels inside,
+        // and more beyond the edge on the widened canvas.
+        let edge = cam.pixel_to_world(0.0, 120.0);
+        let ball = cam.light + 0.7 * (edge - cam.light);
+        let (mut small, mut large) = (Mask::new(320, 240), Mask::new(480, 400));
+        cam.rasterize_sphere(ball, 0.2, &mut small);
+        wide.rasterize_sphere(ball, 0.2, &mut large);
+        let inside = large.cropped(m);
+        let differing = inside.xor_count(&small);
+        assert!(differing <= 2, "{differing} pixels differ");
+        assert!(large.count() > inside.count() && small.count() > 0);
+    }
+}
+
 /// Area of the ellipse in which the cone from the light around a ball (entirely below
 /// the light plane) meets the receiver. With w = S - L, k = |w|^2 - r^2, h the light
 /// height and w_n = w.n, the cone is (w.d)^2 >= k |d|^2; writing it as the conic
