@@ -10,9 +10,11 @@
 //! discs and two DejaVu symbols (heart and spade) as silhouettes; set 3
 //! (`tools/test-pictures-3`), the same kinds drawn for a later session's final code
 //! (letters F, X, Y, V, U, P, the digit 3, a chevron, a hexagon outline, a house, three
-//! discs, and the club and diamond symbols).
+//! discs, and the club and diamond symbols); set 4 (`tools/test-pictures-4`), for the
+//! session after (letters J, M, W, S, G, the digits 6, 9 and 0, an equals sign, a bar
+//! chart, four discs, and the chess rook and bishop symbols).
 //!
-//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1, 2 or 3,
+//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 4,
 //! default 1; DIR default `tools/test-pictures[-SET]`): writes
 //! `DIR/<name>.png` and `DIR/manifest.tsv` (name, objects, extra `bsa new` options),
 //! which `scripts/new-suite.sh` reads. The output depends only on the font file and
@@ -138,6 +140,63 @@ fn dots(x: f64, y: f64) -> bool {
     (x + 150.0).hypot(y + 60.0) <= 80.0
         || (x - 10.0).hypot(y - 20.0) <= 60.0
         || (x - 140.0).hypot(y - 90.0) <= 45.0
+}
+
+fn bars(x: f64, y: f64) -> bool {
+    // A bar chart: three bars 50 wide, 120, 200 and 280 tall, on one baseline.
+    [(-110.0, 120.0), (0.0, 200.0), (110.0, 280.0)]
+        .iter()
+        .any(|&(cx, h)| (x - cx).abs() <= 25.0 && (-140.0..=-140.0 + h).contains(&y))
+}
+
+fn grapes(x: f64, y: f64) -> bool {
+    // Four discs in a diamond, the upper two larger, just apart.
+    (x + 75.0).hypot(y - 60.0) <= 70.0
+        || (x - 75.0).hypot(y - 60.0) <= 70.0
+        || x.hypot(y + 45.0) <= 55.0
+        || x.hypot(y + 150.0) <= 45.0
+}
+
+/// Set 4: defined in a later session before its code was final, run once after it was,
+/// each with its objects stated before any solve.
+fn pictures_4() -> Vec<(&'static str, Shape, String, &'static str)> {
+    let chess_stage = "--width 0.96 --light-height 3";
+    let glyph = |name, c, objects: String| (name, Shape::Glyph(c, 6), objects, "");
+    vec![
+        glyph("letter-j", 'J', format!("{DOUBLE},{UNIT}")),
+        glyph("letter-m", 'M', format!("{DOUBLE}*4")),
+        glyph("letter-w", 'W', format!("{DOUBLE}*4")),
+        glyph("letter-s", 'S', format!("{UNIT}*5,{HALF}*2")),
+        glyph("digit-6", '6', format!("{UNIT}*5,{HALF}*2")),
+        glyph("digit-9", '9', format!("{UNIT}*5,{HALF}*2")),
+        glyph("digit-0", '0', format!("{UNIT}*6")),
+        glyph("equals", '=', format!("{DOUBLE}*2")),
+        ("bars", Shape::Drawn(bars), format!("{DOUBLE}*2,{UNIT}"), ""),
+        (
+            "grapes",
+            Shape::Drawn(grapes),
+            "sphere:0.08*2,sphere:0.06*2".to_string(),
+            "",
+        ),
+        (
+            "rook",
+            Shape::Glyph('\u{265C}', 0),
+            "chess".to_string(),
+            chess_stage,
+        ),
+        (
+            "bishop",
+            Shape::Glyph('\u{265D}', 0),
+            "chess".to_string(),
+            chess_stage,
+        ),
+        (
+            "letter-g",
+            Shape::Glyph('G', 6),
+            format!("{UNIT}*5,{HALF}*2"),
+            "",
+        ),
+    ]
 }
 
 /// Set 3: defined in a later session, run once after that session's code was final,
@@ -471,7 +530,8 @@ fn main() -> Result<(), Box<dyn Error>> {
         "1" => (pictures(), "tools/test-pictures"),
         "2" => (pictures_2(), "tools/test-pictures-2"),
         "3" => (pictures_3(), "tools/test-pictures-3"),
-        other => return Err(format!("SET must be 1, 2 or 3, got {other:?}").into()),
+        "4" => (pictures_4(), "tools/test-pictures-4"),
+        other => return Err(format!("SET must be 1, 2, 3 or 4, got {other:?}").into()),
     };
     let dir = args
         .get(1)
