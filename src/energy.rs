@@ -503,7 +503,7 @@ mod tests {
             Mask::new(300, 250),
             td.mask.clone(),
         ];
-        let mut only = |t: Term| {
+        let only = |t: Term| {
             let mut w = Weights::default();
             w.0[t as usize] = 1.0;
             w
