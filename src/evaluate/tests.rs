@@ -128,6 +128,17 @@ fn held_samples_are_bit_identical_to_full_ones_on_every_example() {
     assert!(contacts > 10, "only {contacts} samples with a contact");
 }
 
+/// Every body 1 m above the image centre, unturned, but the first, moved so that its
+/// shadow straddles the picture's right edge.
+fn centre_all_but_one_on_the_edge(p: &Problem, ws: &mut Workspace) {
+    for pose in ws.poses.iter_mut() {
+        *pose = (DVec3::new(0.0, 0.0, 1.0), DQuat::IDENTITY);
+    }
+    let cam = &p.scene.camera;
+    let edge = cam.pixel_to_world(cam.width_px as f64, 0.5 * cam.height_px as f64);
+    ws.poses[0].0 = edge * (1.0 - 1.0 / cam.light_height()) + DVec3::new(0.0, 0.0, 1.0);
+}
+
 #[test]
 fn shadows_in_image_tells_a_shadow_cut_by_the_image_edge() {
     for name in ["mickey", "thinker"] {
@@ -136,19 +147,16 @@ fn shadows_in_image_tells_a_shadow_cut_by_the_image_edge() {
         p.evaluate(&p.scene.start_parameters(), &Weights::all_ones(), &mut ws);
         let n = p.scene.occluders.len();
         // Every body 1 m above the image centre: all inside.
-        for pose in ws.poses.iter_mut() {
-            *pose = (DVec3::new(0.0, 0.0, 1.0), DQuat::IDENTITY);
-        }
+        centre_all_but_one_on_the_edge(&p, &mut ws);
+        ws.poses[0] = ws.poses[1];
         assert_eq!(p.shadows_in_image(&ws), vec![true; n], "{name}");
         // The first body moved so that its shadow straddles the right edge.
-        let cam = &p.scene.camera;
-        let edge = cam.pixel_to_world(cam.width_px as f64, 0.5 * cam.height_px as f64);
-        ws.poses[0].0 = edge * (1.0 - 1.0 / cam.light_height()) + DVec3::new(0.0, 0.0, 1.0);
+        centre_all_but_one_on_the_edge(&p, &mut ws);
         let inside = p.shadows_in_image(&ws);
         assert!(!inside[0], "{name}: a shadow across the edge is not inside");
         assert!(inside[1..].iter().all(|&b| b), "{name}");
         // Behind the light plane: outside.
-        ws.poses[0].0 = DVec3::new(0.0, 0.0, cam.light_height() + 1.0);
+        ws.poses[0].0 = DVec3::new(0.0, 0.0, p.scene.camera.light_height() + 1.0);
         assert!(!p.shadows_in_image(&ws)[0], "{name}");
     }
 }
@@ -161,12 +169,7 @@ fn a_shadow_beyond_the_picture_counts_as_extra_shadow() {
         let p = scene(name);
         let mut ws = p.workspace();
         p.evaluate(&p.scene.start_parameters(), &Weights::all_ones(), &mut ws);
-        for pose in ws.poses.iter_mut() {
-            *pose = (DVec3::new(0.0, 0.0, 1.0), DQuat::IDENTITY);
-        }
-        let cam = &p.scene.camera;
-        let edge = cam.pixel_to_world(cam.width_px as f64, 0.5 * cam.height_px as f64);
-        ws.poses[0].0 = edge * (1.0 - 1.0 / cam.light_height()) + DVec3::new(0.0, 0.0, 1.0);
+        centre_all_but_one_on_the_edge(&p, &mut ws);
         p.shadow(&mut ws);
         let picture = p.picture_of(&ws.mask);
         assert_eq!(

@@ -141,6 +141,18 @@ fn shifted_word(row: &[u64], w: usize, d: isize) -> u64 {
     }
 }
 
+/// The 4-neighbours of pixel `(x, y)` inside a `w` x `h` image.
+fn neighbours(x: usize, y: usize, w: usize, h: usize) -> impl Iterator<Item = (usize, usize)> {
+    [
+        (x.wrapping_sub(1), y),
+        (x + 1, y),
+        (x, y.wrapping_sub(1)),
+        (x, y + 1),
+    ]
+    .into_iter()
+    .filter(move |&(nx, ny)| nx < w && ny < h)
+}
+
 impl Mask {
     /// An all-zero mask of `width` x `height` pixels.
     pub fn new(width: usize, height: usize) -> Mask {
@@ -172,14 +184,8 @@ impl Mask {
                 while let Some((x, y)) = stack.pop() {
                     count += 1;
                     sum += DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
-                    let near = [
-                        (x.wrapping_sub(1), y),
-                        (x + 1, y),
-                        (x, y.wrapping_sub(1)),
-                        (x, y + 1),
-                    ];
-                    for (nx, ny) in near {
-                        if nx < w && ny < h && self.get(nx, ny) && !label[ny * w + nx] {
+                    for (nx, ny) in neighbours(x, y, w, h) {
+                        if self.get(nx, ny) && !label[ny * w + nx] {
                             label[ny * w + nx] = true;
                             stack.push((nx, ny));
                         }
@@ -215,14 +221,8 @@ impl Mask {
             }
         }
         while let Some((x, y)) = stack.pop() {
-            let near = [
-                (x.wrapping_sub(1), y),
-                (x + 1, y),
-                (x, y.wrapping_sub(1)),
-                (x, y + 1),
-            ];
-            for (nx, ny) in near {
-                if nx < w && ny < h && self.get(nx, ny) && !out.get(nx, ny) {
+            for (nx, ny) in neighbours(x, y, w, h) {
+                if self.get(nx, ny) && !out.get(nx, ny) {
                     out.set(nx, ny);
                     stack.push((nx, ny));
                 }
@@ -483,26 +483,24 @@ impl Mask {
 
     /// `self & !other` as a new mask.
     pub fn and_not(&self, other: &Mask) -> Mask {
-        assert!(
-            self.width == other.width && self.height == other.height,
-            "mask sizes differ"
-        );
-        let mut out = self.clone();
-        for (o, b) in out.words.iter_mut().zip(&other.words) {
-            *o &= !b;
-        }
-        out
+        self.combined(other, |a, b| a & !b)
     }
 
     /// `self & other` as a new mask.
     pub fn and(&self, other: &Mask) -> Mask {
+        self.combined(other, |a, b| a & b)
+    }
+
+    /// A new mask of `f` applied word by word to `self` and `other` (same size); `f`
+    /// must keep every pixel clear where `self` is clear (its row range is kept).
+    fn combined(&self, other: &Mask, f: impl Fn(u64, u64) -> u64) -> Mask {
         assert!(
             self.width == other.width && self.height == other.height,
             "mask sizes differ"
         );
         let mut out = self.clone();
         for (o, b) in out.words.iter_mut().zip(&other.words) {
-            *o &= b;
+            *o = f(*o, *b);
         }
         out
     }
