@@ -248,6 +248,8 @@ pub fn improve(
     let mut flight = FreeFlight::default();
     for _ in 0..options.max_moves {
         let current = problem.evaluate_held(held, params, weights, ws);
+        // The orientations at `t` of the launch kept (the offers below overwrite `ws`).
+        let turned: Vec<DQuat> = ws.poses.iter().map(|p| p.1).collect();
         let bare = problem.target.mask.and_not(&ws.mask);
         let sights = sights(problem, &movable, &bare, ws);
         let hole = bare
@@ -286,13 +288,35 @@ pub fn improve(
                 offer(&candidate, &[i, j], &mut search, ws);
             }
         }
-        if let Some((area, centroid)) = hole {
+        if let Some((area, centroid, (x0, y0))) = hole {
             let on_receiver = problem.canvas.pixel_to_world(centroid.x, centroid.y);
+            // The hole's long axis, to lay a body along as it is sent there: a piece
+            // sent end-on to a part that shows it lying rarely beats the picture it
+            // leaves, and the lay alone cannot follow.
+            let mut seed = Mask::new(bare.width(), bare.height());
+            seed.set(x0, y0);
+            let hole_axis = long_axis(&bare.connected_to(&seed).moments());
             for &i in &movable {
                 let Some(si) = sights[i] else { continue };
                 candidate.copy_from_slice(params);
-                send(problem, &mut candidate, i, on_receiver, si, area as f64);
+                let com = send(problem, &mut candidate, i, on_receiver, si, area as f64);
                 offer(&candidate, &[i], &mut search, ws);
+                let Some(angle) = hole_axis else { continue };
+                if matches!(scene.occluders[i].shape, Shape::Sphere { .. }) {
+                    continue;
+                }
+                let now = turned[i];
+                let sent = candidate.clone();
+                for (axis, turn) in lays(problem, i, now, com, angle) {
+                    candidate.copy_from_slice(&sent);
+                    let mut launch = Launch::get(&candidate, i);
+                    let guess = launch.angular_velocity + axis * (turn / scene.t);
+                    let want = DQuat::from_axis_angle(axis, turn) * now;
+                    launch.angular_velocity =
+                        spin_reaching(problem, i, want, guess, &mut flight).unwrap_or(guess);
+                    launch.set(&mut candidate, i);
+                    offer(&candidate, &[i], &mut search, ws);
+                }
             }
         }
         for &i in &movable {
@@ -313,7 +337,7 @@ pub fn improve(
             if matches!(scene.occluders[i].shape, Shape::Sphere { .. }) {
                 continue;
             }
-            let now = ws.poses[i].1;
+            let now = turned[i];
             let mut turn =
                 |axis: DVec3, angle: f64, exact: bool, search: &mut Search, ws: &mut Workspace| {
                     candidate.copy_from_slice(params);
@@ -355,16 +379,8 @@ pub fn improve(
             // has no long axis to align. (Laying a body whose shadow has one, when the
             // align move does not mend it, cost the planted blocks 0.01 of IoU.)
             if let Some((sight, angle)) = sights[i].and_then(|si| Some((si, si.part_axis?))) {
-                let cam = &scene.camera;
-                let along = (sight.com - cam.light).normalize();
-                let d = cam.u * angle.cos() - cam.v * angle.sin();
-                let d = (d - along * d.dot(along)).normalize_or_zero();
-                let long = now * long_body_axis(&scene.occluders[i].mass);
-                if d != DVec3::ZERO && long.dot(d).abs() < LAID {
-                    for end in [d, -d] {
-                        let (axis, angle) = DQuat::from_rotation_arc(long, end).to_axis_angle();
-                        turn(axis, angle, true, &mut search, ws);
-                    }
+                for (axis, angle) in lays(problem, i, now, sight.com, angle) {
+                    turn(axis, angle, true, &mut search, ws);
                 }
             }
         }
@@ -473,6 +489,7 @@ fn sights(
 /// Set body `i`'s launch velocity in `params` so that its centre of mass is at `t` on
 /// the light's line through `on_receiver`, at the depth where its shadow (now `own`)
 /// has `area` pixels: the shadow's size goes as the inverse of the depth.
+/// Returns the centre of mass aimed at.
 fn send(
     problem: &Problem,
     params: &mut [f64],
@@ -480,7 +497,7 @@ fn send(
     on_receiver: DVec3,
     own: Sight,
     area: f64,
-) {
+) -> DVec3 {
     let scene = &problem.scene;
     let light = scene.camera.light;
     let mut depth = own.depth * (own.area / area).sqrt();
@@ -492,7 +509,9 @@ fn send(
         }
     }
     let depth = depth.clamp(MIN_DEPTH, 1.0);
-    aim(problem, params, i, light + (on_receiver - light) * depth);
+    let com = light + (on_receiver - light) * depth;
+    aim(problem, params, i, com);
+    com
 }
 
 /// Set body `i`'s launch velocity in `params` so that its centre of mass is at `target`
@@ -635,6 +654,24 @@ fn spin_reaching(
 /// laid along it again (about 18 degrees).
 const LAID: f64 = 0.95;
 
+/// The turns (world axis, angle) that lay body `i`, at orientation `now` with its centre
+/// of mass at `com`, with its long axis across the line of sight along the image angle
+/// `angle`, either way round; none when it lies so already (within [`LAID`]).
+fn lays(problem: &Problem, i: usize, now: DQuat, com: DVec3, angle: f64) -> Vec<(DVec3, f64)> {
+    let cam = &problem.scene.camera;
+    let along = (com - cam.light).normalize();
+    let d = cam.u * angle.cos() - cam.v * angle.sin();
+    let d = (d - along * d.dot(along)).normalize_or_zero();
+    let long = now * long_body_axis(&problem.scene.occluders[i].mass);
+    if d == DVec3::ZERO || long.dot(d).abs() >= LAID {
+        return Vec::new();
+    }
+    [d, -d]
+        .iter()
+        .map(|&end| DQuat::from_rotation_arc(long, end).to_axis_angle())
+        .collect()
+}
+
 /// The body-frame direction of a body's long axis: the principal axis of least inertia.
 fn long_body_axis(mass: &crate::geometry::shape::MassProperties) -> DVec3 {
     let k = mass.principal_inertia;
@@ -701,5 +738,36 @@ mod tests {
         flight.reset(&o.mass, launch, p.scene.gravity, t, &p.flight);
         let d = want.conjugate() * flight.orientation(t);
         assert!(d.xyz().length() < 1e-6, "{w} misses by {d}");
+    }
+
+    #[test]
+    fn lays_turn_the_long_axis_along_the_part_across_the_line_of_sight() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/fly");
+        let p = Problem::new(crate::scene::load(&dir).unwrap());
+        let cam = &p.scene.camera;
+        let mass = &p.scene.occluders[0].mass;
+        let com = cam.light + DVec3::new(0.3, -0.2, -2.0);
+        let along = (com - cam.light).normalize();
+        for angle in [0.0f64, 0.7, -1.2] {
+            // Stood on its end, along the line of sight: its shadow has no long axis.
+            let now = DQuat::from_rotation_arc(long_body_axis(mass), along);
+            let turns = lays(&p, 0, now, com, angle);
+            assert_eq!(turns.len(), 2);
+            let d = cam.u * angle.cos() - cam.v * angle.sin();
+            let d = (d - along * d.dot(along)).normalize();
+            let ends: Vec<f64> = turns
+                .iter()
+                .map(|&(axis, a)| {
+                    (DQuat::from_axis_angle(axis, a) * now * long_body_axis(mass)).dot(d)
+                })
+                .collect();
+            assert!(
+                (ends[0] - 1.0).abs() < 1e-9 && (ends[1] + 1.0).abs() < 1e-9,
+                "{ends:?}"
+            );
+            // Laid already: nothing to do.
+            let laid = DQuat::from_axis_angle(turns[0].0, turns[0].1) * now;
+            assert!(lays(&p, 0, laid, com, angle).is_empty());
+        }
     }
 }

@@ -167,8 +167,8 @@ impl Mask {
     }
 
     /// The 4-connected components of the set pixels, in scan order of their first pixel:
-    /// (pixel count, centroid in pixel coordinates, pixel centres at `+0.5`).
-    pub fn blobs(&self) -> Vec<(usize, DVec2)> {
+    /// (pixel count, centroid in pixel coordinates, pixel centres at `+0.5`, first pixel).
+    pub fn blobs(&self) -> Vec<(usize, DVec2, (usize, usize))> {
         let (w, h) = (self.width, self.height);
         let mut label = vec![false; w * h];
         let mut out = Vec::new();
@@ -191,7 +191,7 @@ impl Mask {
                         }
                     }
                 }
-                out.push((count, sum / count as f64));
+                out.push((count, sum / count as f64, (x0, y0)));
             }
         }
         out
