@@ -11,7 +11,8 @@
 //!   is unchanged up to the two shapes; or each is sent to the other's place in space;
 //! - **fill** the largest bare part of the target with body `i`: sent to the line of
 //!   sight through the part's centroid, at the depth where its shadow has the part's
-//!   area;
+//!   area, and, if it is not a sphere and the part is elongated, also laid along the
+//!   part (below; a piece sent there end-on rarely beats the picture it leaves);
 //! - **fit** body `i` to its own part: the target pixels it covers and the bare ones
 //!   connected to them (a body left too small or off-centre on its blob, which CMA-ES
 //!   steps toward slowly when the right size is far: chess pieces that must fly five
@@ -37,7 +38,7 @@
 //! velocity that puts it at a point is exact. Every candidate is evaluated like any
 //! sample and ranked by the solver's rank (contacts first under the constraint mode); the
 //! best one is taken when it ranks better than the current best, and the search repeats
-//! from it. A pass costs at most `n (n - 1) + 2 n + 13 m` samples for `n` launched
+//! from it. A pass costs at most `n (n - 1) + 2 n + 15 m` samples for `n` launched
 //! bodies of which `m` are not spheres, and at most [`POLISHED`] times 6 per moved body
 //! for the polish.
 
