@@ -308,14 +308,9 @@ pub fn improve(
                 }
                 let now = turned[i];
                 let sent = candidate.clone();
-                for (axis, turn) in lays(problem, i, now, com, angle) {
+                for rotation in lays(problem, i, now, com, angle) {
                     candidate.copy_from_slice(&sent);
-                    let mut launch = Launch::get(&candidate, i);
-                    let guess = launch.angular_velocity + axis * (turn / scene.t);
-                    let want = DQuat::from_axis_angle(axis, turn) * now;
-                    launch.angular_velocity =
-                        spin_reaching(problem, i, want, guess, &mut flight).unwrap_or(guess);
-                    launch.set(&mut candidate, i);
+                    turn_spin(problem, &mut candidate, i, now, rotation, true, &mut flight);
                     offer(&candidate, &[i], &mut search, ws);
                 }
             }
@@ -342,15 +337,16 @@ pub fn improve(
             let mut turn =
                 |axis: DVec3, angle: f64, exact: bool, search: &mut Search, ws: &mut Workspace| {
                     candidate.copy_from_slice(params);
-                    let mut launch = Launch::get(&candidate, i);
-                    let guess = launch.angular_velocity + axis * (angle / scene.t);
-                    let want = DQuat::from_axis_angle(axis, angle) * now;
-                    launch.angular_velocity = if exact {
-                        spin_reaching(problem, i, want, guess, &mut flight).unwrap_or(guess)
-                    } else {
-                        guess
-                    };
-                    launch.set(&mut candidate, i);
+                    let rotation = (axis, angle);
+                    turn_spin(
+                        problem,
+                        &mut candidate,
+                        i,
+                        now,
+                        rotation,
+                        exact,
+                        &mut flight,
+                    );
                     offer(&candidate, &[i], search, ws);
                 };
             for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
@@ -582,6 +578,30 @@ fn elongation(m: &Moments) -> Option<f64> {
     let root = (0.25 * (a - c) * (a - c) + b * b).sqrt();
     let (large, small) = (half + root, half - root);
     (small > 0.0).then(|| large / small)
+}
+
+/// Set body `i`'s launch spin in `params` so that its orientation at `t`, `now`, turns by
+/// `rotation` (a world axis and an angle): by adding `angle / t` about the axis to the
+/// spin, which is exact only for a spin about a principal axis, or, when `exact`, by
+/// [`spin_reaching`] from there (the added spin where Newton does not converge).
+fn turn_spin(
+    problem: &Problem,
+    params: &mut [f64],
+    i: usize,
+    now: DQuat,
+    (axis, angle): (DVec3, f64),
+    exact: bool,
+    flight: &mut FreeFlight,
+) {
+    let mut launch = Launch::get(params, i);
+    let guess = launch.angular_velocity + axis * (angle / problem.scene.t);
+    launch.angular_velocity = if exact {
+        let want = DQuat::from_axis_angle(axis, angle) * now;
+        spin_reaching(problem, i, want, guess, flight).unwrap_or(guess)
+    } else {
+        guess
+    };
+    launch.set(params, i);
 }
 
 /// Newton iterations of [`spin_reaching`], at most.

@@ -6,7 +6,7 @@
 use std::path::Path;
 use std::process::Command;
 
-use crate::util::{bsa, quick_solve, root, tmpdir, variant};
+use crate::util::{bsa, quick_solve, root, solve, tmpdir, variant};
 
 #[test]
 fn check_accepts_mickey() {
@@ -40,15 +40,7 @@ fn solve_says_when_a_shadow_reaches_beyond_the_picture() {
             }));
         short_stages(v, 3, 8);
     });
-    let out = d.join("out");
-    let (ok, stdout, err) = bsa(&[
-        "solve",
-        d.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "-q",
-    ]);
-    assert!(ok, "{err}");
+    let stdout = solve(&d, &d.join("out"), &[]);
     let note = stdout
         .lines()
         .find(|l| l.starts_with("note: at t the shadow"))
@@ -63,15 +55,7 @@ fn solve_and_eval_from_the_command_line() {
     // `eval` reads the solution back.
     let d = variant("cli", |v| short_stages(v, 5, 12));
     let out = d.join("out");
-    let (ok, stdout, err) = bsa(&[
-        "solve",
-        d.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-        "--report",
-    ]);
-    assert!(ok, "{err}");
+    let stdout = solve(&d, &out, &["--report"]);
     assert!(
         stdout.contains("IoU at t") && stdout.contains("total samples"),
         "{stdout}"

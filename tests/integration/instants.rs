@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use crate::scene_errors::assert_rejected as rejected;
-use crate::util::{bsa, quick_solve, root, tmpdir, variant};
+use crate::util::{bsa, quick_solve, root, solve, tmpdir, variant};
 
 fn read_json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
@@ -16,21 +16,6 @@ fn short(v: &mut serde_json::Value) {
     for s in v["stages"].as_array_mut().unwrap() {
         s["max_iterations"] = 6.into();
     }
-}
-
-/// A solve of a scene folder into `out` with extra arguments; its stdout.
-fn solve(scene: &Path, out: &Path, extra: &[&str]) -> String {
-    let mut args = vec![
-        "solve",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "-q",
-    ];
-    args.extend_from_slice(extra);
-    let (ok, stdout, err) = bsa(&args);
-    assert!(ok, "{err}");
-    stdout
 }
 
 /// `bsa render` of `launch` in `scene` into `out`, with extra arguments; its stdout.

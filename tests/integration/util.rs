@@ -26,6 +26,21 @@ pub fn bsa(args: &[&str]) -> (bool, String, String) {
     )
 }
 
+/// `bsa solve SCENE --out OUT -q EXTRA...`, which must succeed; its stdout.
+pub fn solve(scene: &Path, out: &Path, extra: &[&str]) -> String {
+    let mut args = vec![
+        "solve",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "-q",
+    ];
+    args.extend_from_slice(extra);
+    let (ok, stdout, err) = bsa(&args);
+    assert!(ok, "{err}");
+    stdout
+}
+
 /// A fresh, empty folder under the system's temporary folder, named after the test.
 pub fn tmpdir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("bsa-test-{}-{name}", std::process::id()));
@@ -114,14 +129,7 @@ pub fn quick_solve(scene: &Path, name: &str) -> PathBuf {
     }
     std::fs::write(d.join("scene.json"), serde_json::to_string(&v).unwrap()).unwrap();
     let out = d.join("out");
-    let (ok, _, err) = bsa(&[
-        "solve",
-        d.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]);
-    assert!(ok, "{err}");
+    solve(&d, &out, &[]);
     out
 }
 
@@ -159,9 +167,7 @@ pub fn shared_quick_solve(name: &str) -> PathBuf {
 pub fn shared_full_solve(name: &str) -> PathBuf {
     shared(format!("full-{name}"), || {
         let out = tmpdir(&format!("shared-full-{name}")).join("out");
-        let scene = format!("scenes/{name}");
-        let (ok, _, err) = bsa(&["solve", &scene, "--out", out.to_str().unwrap(), "--quiet"]);
-        assert!(ok, "{err}");
+        solve(Path::new(&format!("scenes/{name}")), &out, &[]);
         out
     })
 }
