@@ -12,9 +12,12 @@
 //! (letters F, X, Y, V, U, P, the digit 3, a chevron, a hexagon outline, a house, three
 //! discs, and the club and diamond symbols); set 4 (`tools/test-pictures-4`), for the
 //! session after (letters J, M, W, S, G, the digits 6, 9 and 0, an equals sign, a bar
-//! chart, four discs, and the chess rook and bishop symbols).
+//! chart, four discs, and the chess rook and bishop symbols); set 5
+//! (`tools/test-pictures-5`), for the session after that (letters B, C, D, Q, O, the
+//! digit 8, plus and hash signs, a ladder, three discs in a column, and the chess king,
+//! queen and pawn symbols).
 //!
-//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 4,
+//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 5,
 //! default 1; DIR default `tools/test-pictures[-SET]`): writes
 //! `DIR/<name>.png` and `DIR/manifest.tsv` (name, objects, extra `bsa new` options),
 //! which `scripts/new-suite.sh` reads. The output depends only on the font file and
@@ -155,6 +158,56 @@ fn grapes(x: f64, y: f64) -> bool {
         || (x - 75.0).hypot(y - 60.0) <= 70.0
         || x.hypot(y + 45.0) <= 55.0
         || x.hypot(y + 150.0) <= 45.0
+}
+
+fn ladder(x: f64, y: f64) -> bool {
+    // Two rails 40 wide and 340 tall, 180 apart, and three rungs 36 tall between them.
+    let rails = [-90.0, 90.0]
+        .iter()
+        .any(|&cx: &f64| (x - cx).abs() <= 20.0 && y.abs() <= 170.0);
+    let rungs = x.abs() <= 90.0
+        && [-90.0, 0.0, 90.0]
+            .iter()
+            .any(|&cy: &f64| (y - cy).abs() <= 18.0);
+    rails || rungs
+}
+
+fn lights(x: f64, y: f64) -> bool {
+    // Three discs of falling size in a column, apart.
+    x.hypot(y - 120.0) <= 55.0 || x.hypot(y) <= 50.0 || x.hypot(y + 115.0) <= 45.0
+}
+
+/// Set 5: defined in a later session before its code was final (its objects stated
+/// with it), run once after it was.
+fn pictures_5() -> Vec<(&'static str, Shape, String, &'static str)> {
+    let chess_stage = "--width 0.96 --light-height 3";
+    let glyph = |name, c, objects: String| (name, Shape::Glyph(c, 6), objects, "");
+    let chess = |name, c| (name, Shape::Glyph(c, 0), "chess".to_string(), chess_stage);
+    vec![
+        glyph("letter-b", 'B', format!("{DOUBLE},{UNIT}*4,{HALF}*2")),
+        glyph("letter-c", 'C', format!("{UNIT}*4,{HALF}*2")),
+        glyph("letter-d", 'D', format!("{DOUBLE},{UNIT}*4")),
+        glyph("letter-q", 'Q', format!("{UNIT}*6,{HALF}")),
+        glyph("letter-o", 'O', format!("{UNIT}*6")),
+        glyph("digit-8", '8', format!("{UNIT}*6,{HALF}*2")),
+        glyph("plus", '+', format!("{DOUBLE}*2")),
+        glyph("hash", '#', format!("{DOUBLE}*4")),
+        (
+            "ladder",
+            Shape::Drawn(ladder),
+            format!("{DOUBLE}*2,{UNIT}*3"),
+            "",
+        ),
+        (
+            "lights",
+            Shape::Drawn(lights),
+            "sphere:0.08,sphere:0.07,sphere:0.06".to_string(),
+            "",
+        ),
+        chess("king", '\u{265A}'),
+        chess("queen", '\u{265B}'),
+        chess("pawn", '\u{265F}'),
+    ]
 }
 
 /// Set 4: defined in a later session before its code was final, run once after it was,
@@ -531,7 +584,8 @@ fn main() -> Result<(), Box<dyn Error>> {
         "2" => (pictures_2(), "tools/test-pictures-2"),
         "3" => (pictures_3(), "tools/test-pictures-3"),
         "4" => (pictures_4(), "tools/test-pictures-4"),
-        other => return Err(format!("SET must be 1, 2, 3 or 4, got {other:?}").into()),
+        "5" => (pictures_5(), "tools/test-pictures-5"),
+        other => return Err(format!("SET must be 1 to 5, got {other:?}").into()),
     };
     let dir = args
         .get(1)
