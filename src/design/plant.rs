@@ -229,7 +229,8 @@ impl Layout {
 }
 
 /// The strategy a designed scene gets: one object at a time, then all together (for
-/// more than four objects, the pass one at a time runs twice), with the default weights
+/// more than four objects, the pass one at a time runs four times: each pass still
+/// gains where bodies that moved in the last one left room), with the default weights
 /// ([`Weights::default_for`]) and contacts as constraints.
 pub fn default_strategy(objects: usize) -> Value {
     if objects <= 4 {
@@ -237,7 +238,7 @@ pub fn default_strategy(objects: usize) -> Value {
             "stage": {"step": 0.1, "population": 24, "max_iterations": 100, "stagnation": 30},
             "final": {"step": 0.05, "population": 32, "max_iterations": 150, "stagnation": 40}});
     }
-    json!({"kind": "sequential", "order": "auto", "rounds": 2,
+    json!({"kind": "sequential", "order": "auto", "rounds": 4,
         "stage": {"step": 0.05, "population": 24, "max_iterations": 100, "stagnation": 25},
         "final": {"step": 0.02, "population": 32, "max_iterations": 100, "stagnation": 25}})
 }
