@@ -430,7 +430,10 @@ fn camera_keys(
     if leave < end {
         for f in steps(leave, pull, MOVE_STEP_S * fps) {
             let s = (f - leave) / (pull - leave).max(1e-9);
-            keys.push((f, Pose::blend(&close, &following(f), ease(s)), "pull"));
+            // The pull out's last key is the following shot itself; when the bodies come
+            // to rest before the pull out is over, it is the last key of the film.
+            let shot = if s >= 1.0 - 1e-9 { "follow" } else { "pull" };
+            keys.push((f, Pose::blend(&close, &following(f), ease(s)), shot));
         }
         for f in steps(pull, end, FOLLOW_STEP_S * fps) {
             keys.push((f, following(f), "follow"));
