@@ -1,9 +1,5 @@
 #!/usr/bin/env python3
-"""Write scenes/mickey_hold and scenes/fly_hold from scenes/mickey and the hand-made fly.
-
-scenes/fly is now written by `bsa new`; fly_hold was derived from the hand-made scene
-that came before it, kept as tools/fly-by-hand.json, so that this script still writes
-the same fly_hold.
+"""Write scenes/mickey_hold and scenes/fly_hold from scenes/mickey and scenes/fly.
 
     python3 tools/make_hold_scenes.py
 
@@ -65,7 +61,7 @@ def mickey_hold():
 
 
 def fly_hold():
-    s = json.loads((ROOT / "tools" / "fly-by-hand.json").read_text())
+    s = load("fly")
     old_t = s["t"]
     s["name"] = "fly_hold"
     s["t"] = 0.8
