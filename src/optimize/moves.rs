@@ -12,7 +12,8 @@
 //! - **fill** the largest bare part of the target with body `i`: sent to the line of
 //!   sight through the part's centroid, at the depth where its shadow has the part's
 //!   area, and, if it is not a sphere and the part is elongated, also laid along the
-//!   part (below; a piece sent there end-on rarely beats the picture it leaves);
+//!   part (below; a piece sent there end-on rarely beats the picture it leaves); a body
+//!   whose shadow left the canvas, which no image term sees, is sent the same way;
 //! - **fit** body `i` to its own part: the target pixels it covers and the bare ones
 //!   connected to them (a body left too small or off-centre on its blob, which CMA-ES
 //!   steps toward slowly when the right size is far: chess pieces that must fly five
@@ -418,8 +419,9 @@ pub fn improve(
 }
 
 /// The line of sight, depth and own shadow area of every launched body at `t`, after
-/// an evaluation on `ws`; `None` for a body whose shadow misses the picture or that is
-/// not between the light and the receiver.
+/// an evaluation on `ws`; `None` for a body that is not between the light and the
+/// receiver. A body whose shadow misses the canvas gets the area it would have on the
+/// picture's centre line, and no part.
 /// `bare` is the target minus the whole shadow, which `ws` holds.
 fn sights(
     problem: &Problem,
@@ -448,6 +450,28 @@ fn sights(
         problem.shadow_only(&only, ws);
         let area = ws.mask.count() as f64;
         if area == 0.0 {
+            // A shadow beyond the canvas costs nothing in the image terms, and no local
+            // search finds its way back. Its area is taken where it would fall at the
+            // same depth on the picture's centre line (a shadow's size goes with the
+            // depth, hardly with the ray), so that the fill move can send it to a bare
+            // part like any other body.
+            let on_centre = light + (scene.receiver.center - light) * depth;
+            let kept = ws.poses[i];
+            ws.poses[i].0 = kept.0 + (on_centre - com);
+            problem.shadow_only(&only, ws);
+            ws.poses[i] = kept;
+            let area = ws.mask.count() as f64;
+            if area > 0.0 {
+                out[i] = Some(Sight {
+                    com,
+                    on_receiver: light + (com - light) / depth,
+                    depth,
+                    area,
+                    part: None,
+                    axes: None,
+                    part_axis: None,
+                });
+            }
             continue;
         }
         let covered = problem.target.mask.and(&ws.mask);

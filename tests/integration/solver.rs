@@ -450,6 +450,33 @@ fn moves_swap_two_bodies_that_cover_each_others_parts() {
 }
 
 #[test]
+fn a_body_whose_shadow_left_the_canvas_is_sent_back_to_a_bare_part() {
+    // One sphere at its planted place, the other far beyond the picture's side at the
+    // same depth: its shadow is on no pixel of the canvas, so no term of the picture
+    // sees it and a local search cannot bring it back. The fill move must.
+    let (p, planted) = planted_pair("moves-off-canvas");
+    let mut ws = p.workspace();
+    p.evaluate(&planted, &bsa::energy::Weights::all_ones(), &mut ws);
+    let c1 = com(&p, &ws, 1);
+    let mut params = planted.clone();
+    aim(
+        &p,
+        &mut params,
+        1,
+        c1 + glam::DVec3::new(3.0 * p.scene.receiver.width, 0.0, 0.0),
+    );
+    p.evaluate(&params, &bsa::energy::Weights::all_ones(), &mut ws);
+    let mut alone = vec![false; 2];
+    alone[1] = true;
+    p.shadow_only(&alone, &mut ws);
+    assert_eq!(ws.mask.count(), 0, "the shadow must be off the canvas");
+    let (before, best, _) = run_moves(&p, &mut params, &contact_free_first);
+    assert!(before < 0.9, "IoU {before}");
+    assert!(best.iou > 0.97, "IoU {before} -> {}", best.iou);
+    assert_eq!(best.outcome.n_contacts, 0);
+}
+
+#[test]
 fn swapped_bodies_of_close_sizes_get_the_sizes_of_their_new_parts() {
     // Two spheres of close sizes, each where the other should be, the smaller one too low
     // (its shadow too small): a swap at the sizes the parts have now keeps one part too
