@@ -15,9 +15,11 @@
 //! chart, four discs, and the chess rook and bishop symbols); set 5
 //! (`tools/test-pictures-5`), for the session after that (letters B, C, D, Q, O, the
 //! digit 8, plus and hash signs, a ladder, three discs in a column, and the chess king,
-//! queen and pawn symbols).
+//! queen and pawn symbols); set 6 (`tools/test-pictures-6`), drawn after that
+//! session's code was final (lowercase h, n, t, y, k, z, v, x, an exclamation mark, a
+//! zigzag, two discs, and the beamed notes and anchor symbols).
 //!
-//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 5,
+//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 6,
 //! default 1; DIR default `tools/test-pictures[-SET]`): writes
 //! `DIR/<name>.png` and `DIR/manifest.tsv` (name, objects, extra `bsa new` options),
 //! which `scripts/new-suite.sh` reads. The output depends only on the font file and
@@ -175,6 +177,55 @@ fn ladder(x: f64, y: f64) -> bool {
 fn lights(x: f64, y: f64) -> bool {
     // Three discs of falling size in a column, apart.
     x.hypot(y - 120.0) <= 55.0 || x.hypot(y) <= 50.0 || x.hypot(y + 115.0) <= 45.0
+}
+
+fn zigzag(x: f64, y: f64) -> bool {
+    // Three strokes 44 wide through (-240, -100), (-80, 100), (80, -100), (240, 100).
+    let pts = [
+        (-240.0, -100.0),
+        (-80.0, 100.0),
+        (80.0, -100.0),
+        (240.0, 100.0),
+    ];
+    pts.windows(2).any(|w| {
+        let ((ax, ay), (bx, by)): ((f64, f64), (f64, f64)) = (w[0], w[1]);
+        let (dx, dy) = (bx - ax, by - ay);
+        let s = (((x - ax) * dx + (y - ay) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
+        (x - ax - s * dx).hypot(y - ay - s * dy) <= 22.0
+    })
+}
+
+fn two_discs(x: f64, y: f64) -> bool {
+    // A large disc and a smaller one beside it, apart.
+    (x + 70.0).hypot(y) <= 90.0 || (x - 110.0).hypot(y + 20.0) <= 60.0
+}
+
+/// Set 6: defined in a later session after its code was final (its objects stated with
+/// it), and run once.
+fn pictures_6() -> Vec<(&'static str, Shape, String, &'static str)> {
+    let chess_stage = "--width 0.96 --light-height 3";
+    let glyph = |name, c, objects: String| (name, Shape::Glyph(c, 6), objects, "");
+    let chess = |name, c| (name, Shape::Glyph(c, 0), "chess".to_string(), chess_stage);
+    vec![
+        glyph("small-h", 'h', format!("{DOUBLE},{UNIT}*3")),
+        glyph("small-n", 'n', format!("{UNIT}*4")),
+        glyph("small-t", 't', format!("{DOUBLE},{UNIT},{HALF}")),
+        glyph("small-y", 'y', format!("{DOUBLE}*2")),
+        glyph("small-k", 'k', format!("{DOUBLE},{UNIT}*2")),
+        glyph("small-z", 'z', format!("{UNIT}*3")),
+        glyph("small-v", 'v', format!("{DOUBLE}*2")),
+        glyph("small-x", 'x', format!("{DOUBLE}*2")),
+        glyph("exclamation", '!', format!("{DOUBLE},{HALF}")),
+        ("zigzag", Shape::Drawn(zigzag), format!("{DOUBLE}*3"), ""),
+        (
+            "two-discs",
+            Shape::Drawn(two_discs),
+            "sphere:0.12,sphere:0.08".to_string(),
+            "",
+        ),
+        chess("notes", '\u{266B}'),
+        chess("anchor", '\u{2693}'),
+    ]
 }
 
 /// Set 5: defined in a later session before its code was final (its objects stated
@@ -585,7 +636,8 @@ fn main() -> Result<(), Box<dyn Error>> {
         "3" => (pictures_3(), "tools/test-pictures-3"),
         "4" => (pictures_4(), "tools/test-pictures-4"),
         "5" => (pictures_5(), "tools/test-pictures-5"),
-        other => return Err(format!("SET must be 1 to 5, got {other:?}").into()),
+        "6" => (pictures_6(), "tools/test-pictures-6"),
+        other => return Err(format!("SET must be 1 to 6, got {other:?}").into()),
     };
     let dir = args
         .get(1)
