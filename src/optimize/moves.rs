@@ -9,6 +9,8 @@
 //! - **swap** bodies `i` and `j`: each is sent to the other's line of sight from the
 //!   light, at the depth where its own shadow has the other's area, so that the picture
 //!   is unchanged up to the two shapes; or each is sent to the other's place in space;
+//!   or, where both bodies' parts are known (see `fit`), each to the other's part at the
+//!   part's whole size;
 //! - **fill** the largest bare part of the target with body `i`: sent to the line of
 //!   sight through the part's centroid, at the depth where its shadow has the part's
 //!   area, and, if it is not a sphere and the part is elongated, also laid along the
@@ -283,11 +285,24 @@ pub fn improve(
                 send(problem, &mut candidate, j, si.on_receiver, sj, si.area);
                 offer(&candidate, &[i, j], &mut search, ws);
                 // ... or the other's place in space (each part's size changes by the
-                // ratio of the two bodies' sizes).
+                // ratio of the two bodies' sizes) ...
                 candidate.copy_from_slice(params);
                 aim(problem, &mut candidate, i, sj.com);
                 aim(problem, &mut candidate, j, si.com);
                 offer(&candidate, &[i, j], &mut search, ws);
+                // ... or, where both parts are known, the other's part at its whole size:
+                // two bodies each on the other's part, both too small for it (one kept
+                // low under the other's flight), gain nothing from a swap at the sizes
+                // the parts have now.
+                if let (Some((area_i, at_i)), Some((area_j, at_j))) = (si.part, sj.part) {
+                    let canvas = &problem.canvas;
+                    candidate.copy_from_slice(params);
+                    let to_j = canvas.pixel_to_world(at_j.x, at_j.y);
+                    let to_i = canvas.pixel_to_world(at_i.x, at_i.y);
+                    send(problem, &mut candidate, i, to_j, si, area_j);
+                    send(problem, &mut candidate, j, to_i, sj, area_i);
+                    offer(&candidate, &[i, j], &mut search, ws);
+                }
             }
         }
         if let Some((area, centroid, (x0, y0))) = hole {

@@ -450,6 +450,39 @@ fn moves_swap_two_bodies_that_cover_each_others_parts() {
 }
 
 #[test]
+fn bodies_each_small_on_the_others_part_swap_to_the_parts_whole_sizes() {
+    // The planted suite's spheres-9400 (`bash scripts/planted-suite.sh 9400 1`): four
+    // spheres of radii 0.24 to 0.29 m. Its solve left two spheres each on the other's
+    // disc, both far too small for it (one kept low under the other's flight): growing
+    // either in place meets the other's flight, and a swap at the sizes the discs had
+    // then gained nothing (IoU 0.768). Each must go to the other's disc at the disc's
+    // whole size.
+    let d = crate::util::tmpdir("planted-spheres-9400");
+    let dir = d.join("p");
+    let (ok, _, err) = crate::util::bsa(&[
+        "plant",
+        dir.to_str().unwrap(),
+        "--objects",
+        "sphere:0.294,sphere:0.276,sphere:0.243,sphere:0.271",
+        "--seed",
+        "9400",
+        "--width",
+        "4",
+        "--light-height",
+        "6",
+    ]);
+    assert!(ok, "{err}");
+    crate::util::solve(&dir, &d.join("out"), &[]);
+    let solution: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(d.join("out").join("solution.json")).unwrap(),
+    )
+    .unwrap();
+    let iou = solution["iou"].as_f64().unwrap();
+    assert!(iou > 0.97, "IoU {iou}");
+    assert_eq!(solution["n_contacts"].as_u64(), Some(0));
+}
+
+#[test]
 fn a_body_whose_shadow_left_the_canvas_is_sent_back_to_a_bare_part() {
     // One sphere at its planted place, the other far beyond the picture's side at the
     // same depth: its shadow is on no pixel of the canvas, so no term of the picture
