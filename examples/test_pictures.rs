@@ -17,9 +17,12 @@
 //! digit 8, plus and hash signs, a ladder, three discs in a column, and the chess king,
 //! queen and pawn symbols); set 6 (`tools/test-pictures-6`), drawn after that
 //! session's code was final (lowercase h, n, t, y, k, z, v, x, an exclamation mark, a
-//! zigzag, two discs, and the beamed notes and anchor symbols).
+//! zigzag, two discs, and the beamed notes and anchor symbols); set 7
+//! (`tools/test-pictures-7`), drawn after that session's last code change (lowercase a,
+//! e, f, r, u, w, the letter I, percent and question marks, a staircase, three discs in
+//! a row, and the scissors and sun symbols).
 //!
-//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 6,
+//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 7,
 //! default 1; DIR default `tools/test-pictures[-SET]`): writes
 //! `DIR/<name>.png` and `DIR/manifest.tsv` (name, objects, extra `bsa new` options),
 //! which `scripts/new-suite.sh` reads. The output depends only on the font file and
@@ -198,6 +201,53 @@ fn zigzag(x: f64, y: f64) -> bool {
 fn two_discs(x: f64, y: f64) -> bool {
     // A large disc and a smaller one beside it, apart.
     (x + 70.0).hypot(y) <= 90.0 || (x - 110.0).hypot(y + 20.0) <= 60.0
+}
+
+fn steps(x: f64, y: f64) -> bool {
+    // A staircase of three treads 40 thick, each 120 long, rising to the right, joined
+    // by risers 40 wide.
+    let tread = |x0: f64, y0: f64| (x0..=x0 + 120.0).contains(&x) && (y0..=y0 + 40.0).contains(&y);
+    let riser = |x0: f64, y0: f64| (x0..=x0 + 40.0).contains(&x) && (y0..=y0 + 120.0).contains(&y);
+    tread(-200.0, -140.0)
+        || riser(-120.0, -140.0)
+        || tread(-120.0, -60.0)
+        || riser(-40.0, -60.0)
+        || tread(-40.0, 20.0)
+        || riser(40.0, 20.0)
+        || tread(40.0, 100.0)
+}
+
+fn trio(x: f64, y: f64) -> bool {
+    // Three discs in a row, the middle one largest, apart.
+    (x + 150.0).hypot(y) <= 55.0 || x.hypot(y) <= 75.0 || (x - 150.0).hypot(y) <= 55.0
+}
+
+/// Set 7: defined in a later session after its last code change (its objects stated
+/// with it), and run once.
+fn pictures_7() -> Vec<(&'static str, Shape, String, &'static str)> {
+    let chess_stage = "--width 0.96 --light-height 3";
+    let glyph = |name, c, objects: String| (name, Shape::Glyph(c, 6), objects, "");
+    let chess = |name, c| (name, Shape::Glyph(c, 0), "chess".to_string(), chess_stage);
+    vec![
+        glyph("small-a", 'a', format!("{UNIT}*5,{HALF}*2")),
+        glyph("small-e", 'e', format!("{UNIT}*5,{HALF}*2")),
+        glyph("small-f", 'f', format!("{DOUBLE},{UNIT}*2")),
+        glyph("small-r", 'r', format!("{DOUBLE},{UNIT}")),
+        glyph("small-u", 'u', format!("{UNIT}*4")),
+        glyph("small-w", 'w', format!("{DOUBLE}*4")),
+        glyph("letter-i", 'I', DOUBLE.to_string()),
+        glyph("percent", '%', format!("{DOUBLE},{UNIT}*4")),
+        glyph("question", '?', format!("{UNIT}*4,{HALF}*2")),
+        ("steps", Shape::Drawn(steps), format!("{UNIT}*7"), ""),
+        (
+            "trio",
+            Shape::Drawn(trio),
+            "sphere:0.07*2,sphere:0.1".to_string(),
+            "",
+        ),
+        chess("scissors", '\u{2702}'),
+        chess("sun", '\u{263C}'),
+    ]
 }
 
 /// Set 6: defined in a later session after its code was final (its objects stated with
@@ -637,7 +687,8 @@ fn main() -> Result<(), Box<dyn Error>> {
         "4" => (pictures_4(), "tools/test-pictures-4"),
         "5" => (pictures_5(), "tools/test-pictures-5"),
         "6" => (pictures_6(), "tools/test-pictures-6"),
-        other => return Err(format!("SET must be 1 to 6, got {other:?}").into()),
+        "7" => (pictures_7(), "tools/test-pictures-7"),
+        other => return Err(format!("SET must be 1 to 7, got {other:?}").into()),
     };
     let dir = args
         .get(1)
