@@ -383,8 +383,9 @@ fn rank(solved: Option<Solved>, clear: bool, iou: f64) -> (bool, f64, bool, f64)
     }
 }
 
-/// "trial solves (seed as the scene's) under ceilings 0.8 / 0.7 / ...: IoU a / b / ...,
-/// kept c": what the choice was made on.
+/// "trial solves under ceilings 0.8 / 0.7 / ... of the light's height: IoU a / b / ...;
+/// kept the design under c": what the choice was made on (a trial that ended with a
+/// contact says so).
 fn trials_line(seen: &[(f64, Option<Solved>)], kept: f64) -> String {
     let ceilings: Vec<String> = seen.iter().map(|(c, _)| format!("{c}")).collect();
     let ious: Vec<String> = seen
