@@ -211,3 +211,45 @@ fn a_sequence_gets_a_marker_for_each_later_picture() {
         .markers
         .is_empty());
 }
+
+/// Bodies that come to rest before the pull out is over: the film ends on the pull
+/// out's last key, which is the following shot of its instant, and says so.
+#[test]
+fn a_film_that_ends_during_the_pull_out_ends_on_a_following_key() {
+    let (fps, t) = (24.0, 1.2);
+    let map = TimeMap::new(fps, t, None);
+    let readable = Readable {
+        iou_at_t: 1.0,
+        before_s: 0.05,
+        after_s: 0.05,
+    };
+    let pose = |x: f64| {
+        let location = DVec3::new(x, -5.0, 2.0);
+        Pose {
+            location,
+            rotation: glam::DQuat::IDENTITY,
+            aim: location - DVec3::Z,
+        }
+    };
+    let close = pose(0.0);
+    let end_at = |end_s: f64| {
+        camera_keys(
+            &map,
+            t,
+            &readable,
+            0,
+            map.frame_of(end_s).round() as i64,
+            close,
+            |s| pose(s),
+        )
+    };
+    // The film ends a little after the close shot is left: within the pull out.
+    let leave = map.frame_of(t + 0.5) + CLOSE_AFTER_S * fps;
+    let keys = end_at(map.time_of(leave + 0.5 * PULL_OUT_S * fps));
+    let last = keys.last().unwrap();
+    assert_eq!(last.shot, "follow", "{keys:?}");
+    let follow = pose(map.time_of(last.frame));
+    assert!((DVec3::from_array(last.location) - follow.location).length() < 1e-9);
+    // A film that ends well after the pull out ends on a following key too.
+    assert_eq!(end_at(t + 4.0).last().unwrap().shot, "follow");
+}
