@@ -240,7 +240,7 @@ fn a_film_that_ends_during_the_pull_out_ends_on_a_following_key() {
             0,
             map.frame_of(end_s).round() as i64,
             close,
-            |s| pose(s),
+            pose,
         )
     };
     // The film ends a little after the close shot is left: within the pull out.
