@@ -294,13 +294,10 @@ pub fn improve(
                 // two bodies each on the other's part, both too small for it (one kept
                 // low under the other's flight), gain nothing from a swap at the sizes
                 // the parts have now.
-                if let (Some((area_i, at_i)), Some((area_j, at_j))) = (si.part, sj.part) {
-                    let canvas = &problem.canvas;
+                if let (Some(part_i), Some(part_j)) = (si.part, sj.part) {
                     candidate.copy_from_slice(params);
-                    let to_j = canvas.pixel_to_world(at_j.x, at_j.y);
-                    let to_i = canvas.pixel_to_world(at_i.x, at_i.y);
-                    send(problem, &mut candidate, i, to_j, si, area_j);
-                    send(problem, &mut candidate, j, to_i, sj, area_i);
+                    send_to_part(problem, &mut candidate, i, si, part_j);
+                    send_to_part(problem, &mut candidate, j, sj, part_i);
                     offer(&candidate, &[i, j], &mut search, ws);
                 }
             }
@@ -333,16 +330,15 @@ pub fn improve(
         }
         for &i in &movable {
             let Some(si) = sights[i] else { continue };
-            let Some((area, centroid)) = si.part else {
+            let Some(part) = si.part else {
                 continue;
             };
             // Close to its part's size already: the local search does the rest.
-            if (si.area / area).ln().abs() < FIT_TOLERANCE.ln() {
+            if (si.area / part.0).ln().abs() < FIT_TOLERANCE.ln() {
                 continue;
             }
-            let on_receiver = problem.canvas.pixel_to_world(centroid.x, centroid.y);
             candidate.copy_from_slice(params);
-            send(problem, &mut candidate, i, on_receiver, si, area);
+            send_to_part(problem, &mut candidate, i, si, part);
             offer(&candidate, &[i], &mut search, ws);
         }
         for &i in &movable {
@@ -548,6 +544,15 @@ fn send(
     let com = light + (on_receiver - light) * depth;
     aim(problem, params, i, com);
     com
+}
+
+/// [`send`] body `i` (now `own`) to a part of the picture, `(area, centroid)` as
+/// [`Sight::part`] gives it: onto the line of sight through the centroid, at the size of
+/// the whole part.
+fn send_to_part(problem: &Problem, params: &mut [f64], i: usize, own: Sight, part: (f64, DVec2)) {
+    let (area, centroid) = part;
+    let on_receiver = problem.canvas.pixel_to_world(centroid.x, centroid.y);
+    send(problem, params, i, on_receiver, own, area);
 }
 
 /// Set body `i`'s launch velocity in `params` so that its centre of mass is at `target`

@@ -5,11 +5,7 @@
 use std::path::Path;
 
 use crate::scene_errors::assert_rejected as rejected;
-use crate::util::{bsa, quick_solve, root, solve, tmpdir, variant};
-
-fn read_json(path: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
+use crate::util::{bsa, quick_solve, read_json, root, solve, tmpdir, variant};
 
 /// Mickey's stages cut to a few iterations, so that a solve takes a fraction of a second.
 fn short(v: &mut serde_json::Value) {

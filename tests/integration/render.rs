@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::util::{bsa, quick_solve, root, solve, tmpdir};
+use crate::util::{bsa, quick_solve, read_json, root, solve, tmpdir};
 
 fn render(scene: &Path, launch: &Path, out: &Path) -> (bool, String, String) {
     bsa(&[
@@ -411,9 +411,7 @@ fn new_keeps_the_design_that_solves_best_and_solve_ends_where_its_trial_did() {
     // The written scene is the design that was tried: its solve ends where the trial did.
     let solved = d.join("out");
     solve(&dir, &solved, &[]);
-    let solution: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(solved.join("solution.json")).unwrap())
-            .unwrap();
+    let solution = read_json(&solved.join("solution.json"));
     let iou = solution["iou"].as_f64().unwrap();
     assert!(
         (iou - best).abs() < 1e-4,

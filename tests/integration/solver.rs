@@ -335,8 +335,7 @@ fn planted_spheres(name: &str, objects: &str) -> (Problem, Vec<f64>) {
     ]);
     assert!(ok, "{err}");
     let p = Problem::new(bsa::scene::load(&dir).unwrap());
-    let planted: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("planted.json")).unwrap()).unwrap();
+    let planted = crate::util::read_json(&dir.join("planted.json"));
     let mut params = vec![0.0; p.scene.variable_count()];
     for (i, o) in p.scene.occluders.iter().enumerate() {
         let l = &planted[&o.name];
@@ -473,10 +472,7 @@ fn bodies_each_small_on_the_others_part_swap_to_the_parts_whole_sizes() {
     ]);
     assert!(ok, "{err}");
     crate::util::solve(&dir, &d.join("out"), &[]);
-    let solution: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(d.join("out").join("solution.json")).unwrap(),
-    )
-    .unwrap();
+    let solution = crate::util::read_json(&d.join("out").join("solution.json"));
     let iou = solution["iou"].as_f64().unwrap();
     assert!(iou > 0.97, "IoU {iou}");
     assert_eq!(solution["n_contacts"].as_u64(), Some(0));

@@ -41,6 +41,11 @@ pub fn solve(scene: &Path, out: &Path, extra: &[&str]) -> String {
     stdout
 }
 
+/// The JSON file at `path`, which must exist and parse.
+pub fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
 /// A fresh, empty folder under the system's temporary folder, named after the test.
 pub fn tmpdir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("bsa-test-{}-{name}", std::process::id()));
