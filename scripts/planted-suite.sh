@@ -11,6 +11,9 @@
 #   boxes12   8 to 12 such blocks, 2 m picture
 #   chess     6 chess pieces (scenes/thinker/pieces), 0.96 m picture, light 3 m up
 #   mix       2 or 3 spheres and 2 or 3 blocks, 1.6 m picture
+# ROUTE=new takes the user's way instead: `bsa new` designs a scene from the planted
+# target and the same objects (its own launch positions, hints, heights and trial solves),
+# then `bsa solve` solves it; the wall time is then that of both commands.
 # Problems and solves go to $ROOT/<class>-<seed>/ (ROOT defaults to /tmp/bsa-planted);
 # BSA=PATH runs another binary (e.g. an older build, for a side-by-side comparison); prints one line per problem
 # and a table per class: IoU (min / median / max), solves with a contact before t,
@@ -62,13 +65,25 @@ for class in spheres boxes boxes12 chess mix; do
             echo "$class seed $seed: plant failed: $(tail -1 "$dir.plant.log")"
             continue
         fi
-        $bsa solve "$dir" --out "$dir/out" -q >"$dir.solve.log" 2>&1 ||
+        scene=$dir
+        started=$(date +%s.%N)
+        if [ "${ROUTE:-plant}" = new ]; then
+            scene=$dir/new
+            $bsa new "$scene" --target "$dir/target.png" --objects "$objects" --width "$width" \
+                --light-height "$light" >"$dir.new.log" 2>&1 ||
+                { echo "$class seed $seed: new failed, see $dir.new.log"; continue; }
+        fi
+        $bsa solve "$scene" --out "$scene/out" -q >"$dir.solve.log" 2>&1 ||
             { echo "$class seed $seed: solve failed, see $dir.solve.log"; continue; }
-        python3 - "$dir/out/solution.json" "$class" "$seed" "$objects" >>"$results" <<'PY'
+        ended=$(date +%s.%N)
+        python3 - "$scene/out/solution.json" "$class" "$seed" "${ROUTE:-plant}" "$started" "$ended" \
+            >>"$results" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))
+# The plant route reports the solver's own wall time; the new route both commands'.
+wall = s["wall_time_s"] if sys.argv[4] != "new" else float(sys.argv[6]) - float(sys.argv[5])
 print("\t".join(map(str, [sys.argv[2], sys.argv[3], s["iou"], s["n_contacts"], s["samples"],
-                          s["wall_time_s"], len(s["occluders"])])))
+                          wall, len(s["occluders"])])))
 PY
         tail -1 "$results" | awk -F'\t' '{printf "%s seed %s: %d objects, IoU %.4f, %d contacts, %d samples, %.2f s\n", $1, $2, $7, $3, $4, $5, $6}'
     done

@@ -18,10 +18,10 @@ fn main() {
         for cause in err.chain().skip(1) {
             eprintln!("  caused by: {cause}");
         }
-        // An interrupted solve saved its progress and said how to resume; it still did
-        // not finish, so it must not look like success (or like any other failure).
-        let interrupted = err.downcast_ref::<bsa::cli::guard::Interrupted>().is_some();
-        std::process::exit(if interrupted {
+        // An interrupted solve saved its progress and said how to resume (an interrupted
+        // `bsa new` wrote nothing); it still did not finish, so it must not look like
+        // success (or like any other failure).
+        std::process::exit(if bsa::cli::guard::is_interruption(&err) {
             bsa::cli::guard::EXIT_INTERRUPTED
         } else {
             1

@@ -44,6 +44,20 @@ pub struct Interrupted {
     pub out: String,
 }
 
+/// A command that was interrupted before it wrote anything (`bsa new`): the folder holds
+/// what it held before. `main` turns it into [`EXIT_INTERRUPTED`].
+#[derive(Debug, thiserror::Error)]
+#[error("interrupted: no scene written; {dir} holds what it held before")]
+pub struct NothingWritten {
+    pub dir: String,
+}
+
+/// Whether `err` is an interruption ([`Interrupted`] or [`NothingWritten`]), which exits
+/// with [`EXIT_INTERRUPTED`].
+pub fn is_interruption(err: &anyhow::Error) -> bool {
+    err.downcast_ref::<Interrupted>().is_some() || err.downcast_ref::<NothingWritten>().is_some()
+}
+
 /// Holds the lock on an output folder for the duration of a solve.
 pub struct OutputGuard {
     dir: PathBuf,

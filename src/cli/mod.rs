@@ -12,7 +12,8 @@
 //! its raw clap arguments (the `*Args` structs below) are turned once into a validated
 //! `Options` struct, and only then does any work start, through library calls. Shared
 //! helpers: [`load`] (a scene, a solution folder), [`progress`] (progress bars and the
-//! solve observer) and [`blender`] (the Python with `bpy` and its scripts).
+//! solve observer), [`scratch`] (the dot-files `new` and `plant` work in until their
+//! scene is complete) and [`blender`] (the Python with `bpy` and its scripts).
 //! This is the only module that uses `anyhow`, prints, draws progress bars or installs
 //! the Ctrl-C handler; library modules return typed errors.
 
@@ -30,6 +31,7 @@ mod outdir;
 mod plant;
 mod progress;
 mod render;
+mod scratch;
 mod solve;
 mod validate;
 mod video;

@@ -11,9 +11,15 @@
 //! strategy) and the one whose solve ends at the best picture, contact-free first, is
 //! written. A start guess's IoU says little of where its solve ends: on 27 held-out
 //! pictures the design with the best start was the best solved one for 12.
+//!
+//! Until the scene is written, `bsa new` works in scratch files in the folder (a copy of
+//! the target, the first scene, one scene per design; [`Scratch`] removes them however
+//! the command ends): an error or a Ctrl-C leaves the folder's `scene.json` and
+//! `target.png` as they were, and the folder's scene is only replaced, target first, once
+//! the new one is complete.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicUsize;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
@@ -30,8 +36,19 @@ use crate::optimize::solver::{self, Silent, SolveOptions};
 use crate::output::files;
 use crate::scene::Scene;
 
+use super::guard::NothingWritten;
 use super::plant::Design;
+use super::scratch::Scratch;
 use super::{load, progress, NewArgs};
+
+/// Ctrl-C presses (and SIGTERMs) during `bsa new`: the trial solves stop at once, and
+/// no scene is written.
+static INTERRUPTS: AtomicUsize = AtomicUsize::new(0);
+
+/// The scratch copy of the target that the first scene and the designs load.
+const SCRATCH_TARGET: &str = ".bsa-new-target.png";
+/// The first scene (one object of each kind), which reads and checks every input.
+const SCRATCH_PROBE: &str = ".bsa-new-probe.json";
 
 /// The validated options of `bsa new`.
 pub(super) struct Options {
@@ -194,15 +211,33 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     };
     let dir = &opts.dir;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    files::write_atomic(&dir.join("target.png"), &bytes)?;
+    let design_files: Vec<PathBuf> = (0..design::CEILINGS.len())
+        .map(|k| dir.join(format!(".bsa-new-design-{k}.json")))
+        .collect();
+    let mut scratch = Scratch::new(
+        [dir.join(SCRATCH_TARGET), dir.join(SCRATCH_PROBE)]
+            .into_iter()
+            .chain(design_files.iter().cloned())
+            .collect(),
+        dir,
+    );
+    files::write_atomic(&dir.join(SCRATCH_TARGET), &bytes)?;
+    // With ctrlc's "termination" feature this handles SIGTERM (and SIGHUP) like Ctrl-C.
+    ctrlc::set_handler(|| {
+        if INTERRUPTS.fetch_add(2, Ordering::SeqCst) == 0 {
+            eprintln!("\ninterrupt: stopping; no scene will be written");
+        }
+    })
+    .context("cannot install the Ctrl-C handler")?;
     let name = dir
         .file_name()
         .and_then(|s| s.to_str())
         .unwrap_or("scene")
         .to_string();
     let scene_file = dir.join("scene.json");
-    let write = |json: &Value| -> Result<()> {
-        files::write_atomic(&scene_file, serde_json::to_string_pretty(json)?.as_bytes())?;
+    let probe_file = dir.join(SCRATCH_PROBE);
+    let write = |file: &Path, json: &Value| -> Result<()> {
+        files::write_atomic(file, serde_json::to_string_pretty(json)?.as_bytes())?;
         Ok(())
     };
     // A first scene with one object of each kind, far apart above the table: loading it
@@ -214,8 +249,8 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         probe["occluders"] = json!([{"name": "probe", "shape": {"sphere": {"radius": 0.01}},
                                      "position": [0.0, 0.0, 1.0], "density": 1000.0}]);
     }
-    write(&probe)?;
-    let scene = load::scene(dir)
+    write(&probe_file, &probe)?;
+    let scene = load::scene(&probe_file)
         .with_context(|| format!("from --target {} and --objects", opts.target.display()))?;
     check_sizes(&scene, protos.len())?;
     let objects: Vec<Object> = protos
@@ -261,7 +296,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         .par_iter()
         .enumerate()
         .map(|(k, &ceiling)| {
-            let file = dir.join(format!(".bsa-new-design-{k}.json"));
+            let file = &design_files[k];
             let variant = design_variant(
                 &picture,
                 Geometry {
@@ -269,17 +304,23 @@ pub(super) fn run(opts: &Options) -> Result<()> {
                     ..geometry.clone()
                 },
                 &request,
-                &file,
+                file,
                 &name,
                 opts.seed,
                 trial,
             );
-            let _ = std::fs::remove_file(&file);
+            let _ = std::fs::remove_file(file);
             bar.inc(1);
             variant
         })
         .collect();
     bar.finish_and_clear();
+    if INTERRUPTS.load(Ordering::SeqCst) > 0 {
+        return Err(NothingWritten {
+            dir: dir.display().to_string(),
+        }
+        .into());
+    }
     let mut best: Option<Variant> = None;
     let mut first_error = None;
     // Each design's ceiling and trial solve, for the line that reports them.
@@ -300,13 +341,21 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let Some(Variant { plan, moves, .. }) = best else {
         return Err(first_error.expect("every ceiling gave a design or an error"));
     };
+    // The folder's scene is replaced only now, target first: a scene.json is never left
+    // beside a target it was not made for.
+    files::write_atomic(&dir.join("target.png"), &bytes)?;
+    write(
+        &scene_file,
+        &plan.scene_json(&name, "target.png", opts.seed),
+    )?;
+    scratch.written = true;
+    drop(scratch);
     if trial {
         println!(
             "{name}: {}",
             trials_line(&variants_seen, plan.geometry.ceiling)
         );
     }
-    write(&plan.scene_json(&name, "target.png", opts.seed))?;
     // What the user gets: the scene as written, loaded afresh.
     let problem = Problem::new(load::scene(dir)?);
     let mut ws = problem.workspace();
@@ -416,7 +465,7 @@ fn design_variant(
     trial: bool,
 ) -> Result<Variant> {
     let mut plan = design::design(picture, geometry, request)?;
-    let json = plan.scene_json(name, "target.png", seed);
+    let json = plan.scene_json(name, SCRATCH_TARGET, seed);
     files::write_atomic(file, serde_json::to_string_pretty(&json)?.as_bytes())?;
     let mut problem = Problem::new(load::scene(file)?);
     let n = plan.objects.len();
@@ -442,14 +491,14 @@ fn design_variant(
 /// (so the same start, strategy and seed), loaded afresh. One thread: the designs are
 /// solved side by side, and a solve's result does not depend on its thread count.
 fn trial_solve(plan: &Plan, file: &Path, name: &str, seed: u64) -> Result<Solved> {
-    let json = plan.scene_json(name, "target.png", seed);
+    let json = plan.scene_json(name, SCRATCH_TARGET, seed);
     files::write_atomic(file, serde_json::to_string_pretty(&json)?.as_bytes())?;
     let problem = Problem::new(load::scene(file)?);
     let options = SolveOptions {
         threads: Some(1),
         ..SolveOptions::default()
     };
-    let (solution, _) = solver::solve(&problem, &options, &mut Silent, &AtomicUsize::new(0));
+    let (solution, _) = solver::solve(&problem, &options, &mut Silent, &INTERRUPTS);
     Ok(Solved {
         iou: solution.iou,
         clear: solution.n_contacts == 0,
@@ -486,7 +535,7 @@ fn probe_json(protos: &[Prototype], stage: &Stage, name: &str) -> Value {
         .collect();
     json!({
         "name": name,
-        "target": "target.png",
+        "target": SCRATCH_TARGET,
         "t": stage.t,
         "light": [0.0, 0.0, stage.light_height],
         "receiver": {"center": [0.0, 0.0, 0.0], "u": [1.0, 0.0, 0.0], "v": [0.0, 1.0, 0.0],

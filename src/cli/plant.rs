@@ -13,6 +13,7 @@ use crate::output::{files, picture};
 use crate::scene::Launch;
 use crate::shadow::mask::Mask;
 
+use super::scratch::Scratch;
 use super::{load, DesignArgs, PlantArgs};
 
 /// Draws before `bsa plant` gives up on an inventory.
@@ -97,24 +98,31 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         .unwrap_or("planted")
         .to_string();
     let (w, h) = opts.stage.pixels;
+    // The draw works in scratch files: the folder's scene is replaced only once the new
+    // one is complete (see `scratch`).
+    let (scratch_target, scratch_scene) = (".bsa-plant-target.png", ".bsa-plant-scene.json");
+    let mut scratch = Scratch::new(vec![dir.join(scratch_target), dir.join(scratch_scene)], dir);
+    let write_scene =
+        |file: &str, target: &str, hints: &[(usize, glam::DVec3, glam::DVec2)]| -> Result<()> {
+            let json = layout.scene_json(&name, target, hints, opts.seed);
+            files::write_atomic(
+                &dir.join(file),
+                serde_json::to_string_pretty(&json)?.as_bytes(),
+            )?;
+            Ok(())
+        };
     // The scene needs a target to load: a placeholder until the draw gives the real one.
     let placeholder = Mask::from_fn(w, h, |x, y| x == w / 2 && y == h / 2);
-    write_target(dir, &placeholder)?;
-    let scene_file = dir.join("scene.json");
-    let write_scene = |hints: &[(usize, glam::DVec3, glam::DVec2)]| -> Result<()> {
-        let json = layout.scene_json(&name, "target.png", hints, opts.seed);
-        files::write_atomic(&scene_file, serde_json::to_string_pretty(&json)?.as_bytes())?;
-        Ok(())
-    };
-    write_scene(&[])?;
-    let problem = Problem::new(load::scene(dir)?);
+    write_target(&dir.join(scratch_target), &placeholder)?;
+    write_scene(scratch_scene, scratch_target, &[])?;
+    let problem = Problem::new(load::scene(&dir.join(scratch_scene))?);
     let params = plant::draw_launch(&problem, opts.seed, ATTEMPTS)?;
     let mut ws = problem.workspace();
     problem.evaluate(&params, &Weights::default(), &mut ws);
     let target = problem.picture_of(&ws.mask);
-    write_target(dir, &target)?;
     let hints = plant::hints(&problem, &target);
-    write_scene(&hints)?;
+    write_target(&dir.join("target.png"), &target)?;
+    write_scene("scene.json", "target.png", &hints)?;
     // The planted launch, as a launch file `bsa render` reads.
     let scene = &problem.scene;
     let mut launch = serde_json::Map::new();
@@ -129,6 +137,8 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         &dir.join("planted.json"),
         serde_json::to_string_pretty(&launch)?.as_bytes(),
     )?;
+    scratch.written = true;
+    drop(scratch);
     // The scene as a user gets it: loads, and its start guess aimed at the hints.
     let problem = Problem::new(load::scene(dir)?);
     let start = problem.evaluate(
@@ -148,8 +158,8 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     Ok(())
 }
 
-fn write_target(dir: &std::path::Path, mask: &Mask) -> Result<()> {
+fn write_target(file: &std::path::Path, mask: &Mask) -> Result<()> {
     let img = picture::mask_image(mask.width(), mask.height(), &|x, y| mask.get(x, y));
-    files::save_png(&img, &dir.join("target.png"))?;
+    files::save_png(&img, file)?;
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! Faults and bad input of the audit of issue #13: every case gets a clear error naming
 //! the file and the field (never a panic, an abort or a hang), and a good result already
-//! in the output folder survives an interrupted or failing solve.
+//! in the output folder survives an interrupted or failing solve, as a scene in its
+//! folder survives a `bsa new` or `bsa plant` that fails or is interrupted.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -432,4 +433,116 @@ fn output_piped_into_a_reader_that_goes_away_is_no_panic() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("panicked"), "{err}");
     assert_ne!(out.status.code(), Some(101), "{err}");
+}
+
+/// A folder holding a scene of its own: its `scene.json` and `target.png` (Mickey's).
+fn folder_with_a_scene(name: &str) -> (PathBuf, Vec<u8>, Vec<u8>) {
+    let dir = tmpdir(name);
+    let scene = b"{\"a scene\": \"of the user's\"}".to_vec();
+    let target = std::fs::read(root().join("scenes/mickey/target.png")).unwrap();
+    std::fs::write(dir.join("scene.json"), &scene).unwrap();
+    std::fs::write(dir.join("target.png"), &target).unwrap();
+    (dir, scene, target)
+}
+
+/// The folder holds its scene as it was, and nothing else.
+fn assert_untouched(dir: &Path, scene: &[u8], target: &[u8]) {
+    assert_eq!(
+        std::fs::read(dir.join("scene.json")).unwrap(),
+        scene,
+        "scene.json changed"
+    );
+    assert_eq!(
+        std::fs::read(dir.join("target.png")).unwrap(),
+        target,
+        "target.png changed"
+    );
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["scene.json", "target.png"],
+        "files left in {}",
+        dir.display()
+    );
+}
+
+#[test]
+fn new_refusing_its_input_leaves_the_folders_scene_as_it_was() {
+    // Before the fix the first scene (one object of each kind) replaced scene.json and
+    // the new target replaced target.png before the objects were checked.
+    let (dir, scene, target) = folder_with_a_scene("new-refused");
+    let fly = root().join("scenes/fly/target.png");
+    for objects in ["sphere:5", "chess,sphere:5"] {
+        let (ok, _, err) = bsa(&[
+            "new",
+            dir.to_str().unwrap(),
+            "--target",
+            fly.to_str().unwrap(),
+            "--objects",
+            objects,
+        ]);
+        assert!(!ok && err.contains("larger than the"), "{objects}: {err}");
+        assert_untouched(&dir, &scene, &target);
+    }
+}
+
+#[test]
+fn an_interrupted_new_writes_nothing_and_leaves_no_scratch_files() {
+    let (dir, scene, target) = folder_with_a_scene("new-interrupted");
+    let thinker = root().join("scenes/thinker/target.png");
+    let child = Command::new(env!("CARGO_BIN_EXE_bsa"))
+        .args([
+            "new",
+            dir.to_str().unwrap(),
+            "--target",
+            thinker.to_str().unwrap(),
+            "--objects",
+            "chess",
+            "--width",
+            "0.96",
+            "--light-height",
+            "3",
+        ])
+        .current_dir(root())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Once a design's scratch scene exists, the designs and their trial solves are under
+    // way (they take seconds for sixteen pieces).
+    let start = Instant::now();
+    while !dir.join(".bsa-new-design-0.json").exists() && start.elapsed() < Duration::from_secs(60)
+    {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(200));
+    let _ = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status();
+    let result = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&result.stderr);
+    assert_eq!(result.status.code(), Some(130), "{err}");
+    assert!(err.contains("no scene written"), "{err}");
+    assert_untouched(&dir, &scene, &target);
+}
+
+#[test]
+fn plant_failing_to_draw_leaves_the_folders_scene_as_it_was() {
+    // Before the fix a placeholder scene and target replaced the folder's before the
+    // draw, which fails here.
+    let (dir, scene, target) = folder_with_a_scene("plant-refused");
+    let (ok, _, err) = bsa(&[
+        "plant",
+        dir.to_str().unwrap(),
+        "--objects",
+        "sphere:0.5*40",
+        "--width",
+        "1",
+    ]);
+    assert!(!ok && err.contains("does not fit"), "{err}");
+    assert_untouched(&dir, &scene, &target);
 }
