@@ -250,8 +250,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
                                      "position": [0.0, 0.0, 1.0], "density": 1000.0}]);
     }
     write(&probe_file, &probe)?;
-    let scene = load::scene(&probe_file)
-        .with_context(|| format!("from --target {} and --objects", opts.target.display()))?;
+    let scene = load::scene(&probe_file).map_err(|e| in_users_terms(e, &opts.target, &protos))?;
     check_sizes(&scene, protos.len())?;
     let objects: Vec<Object> = protos
         .iter()
@@ -505,9 +504,68 @@ fn trial_solve(plan: &Plan, file: &Path, name: &str, seed: u64) -> Result<Solved
     })
 }
 
-/// An object whose shadow is wider than the picture cannot be part of it.
+/// An error of the first scene, which is a scratch file the user never wrote, told in
+/// terms of the command's own inputs: `--target`, or the `--objects` item at fault.
+fn in_users_terms(err: anyhow::Error, target: &Path, protos: &[Prototype]) -> anyhow::Error {
+    use crate::scene::SceneError;
+    let target = target.display();
+    // `occluders[k]...` of the first scene is the k-th distinct object of the list.
+    let object = |field: &str| -> Option<String> {
+        let k: usize = field
+            .strip_prefix("occluders[")?
+            .split(']')
+            .next()?
+            .parse()
+            .ok()?;
+        let p = protos.get(k)?;
+        Some(match p.shape.get("mesh").and_then(|m| m.get("obj")) {
+            Some(obj)
+                if p.stem != "mesh" && obj.as_str().is_some_and(|o| o.starts_with("pieces/")) =>
+            {
+                format!("the chess {}", p.stem)
+            }
+            Some(obj) => format!("mesh:{}", obj.as_str().unwrap_or("?")),
+            None => format!("the {} {}", p.stem, p.shape),
+        })
+    };
+    match err.downcast_ref::<SceneError>() {
+        Some(SceneError::TargetEmpty { .. }) => anyhow::anyhow!(
+            "--target {target}: the picture has no dark pixel (dark = luminance below half, opaque); there is nothing to make"
+        ),
+        Some(SceneError::TargetNotPng { reason, .. }) => {
+            anyhow::anyhow!("--target {target} is not a readable PNG: {reason}")
+        }
+        Some(SceneError::Obj { field, error, .. }) => match object(field) {
+            Some(what) => anyhow::anyhow!("--objects: {what}: {error}"),
+            None => err,
+        },
+        Some(SceneError::Field { field, reason, .. }) => match object(field) {
+            Some(what) => anyhow::anyhow!("--objects: {what}: {reason}"),
+            None => err,
+        },
+        _ => err.context(format!("from --target {target} and --objects")),
+    }
+}
+
+/// An object whose shadow is wider than the picture cannot be part of it; one whose
+/// shadow is smaller than a pixel even at the highest ceiling cannot be seen in it.
 fn check_sizes(scene: &Scene, count: usize) -> Result<()> {
+    let pixel = scene.receiver.width / scene.target.width() as f64;
+    // A body under the highest ceiling, a share c of the light's height above the
+    // picture, casts a shadow 1 / (1 - c) times its size.
+    let magnified = 1.0 / (1.0 - design::CEILINGS[0]);
     for o in scene.occluders.iter().take(count) {
+        let most = 2.0 * o.bounding_radius * magnified;
+        if most < pixel {
+            bail!(
+                "object `{}` ({:.2e} m across) casts a shadow of at most {:.2e} m, less than one pixel ({:.2e} m) of the {:.2} m wide picture: use larger objects or a narrower picture (--width)",
+                o.name,
+                2.0 * o.bounding_radius,
+                most,
+                pixel,
+                scene.receiver.width
+            );
+        }
         let shadow = 2.0 * o.bounding_radius * 1.5;
         if shadow > scene.receiver.width.min(scene.receiver.height) {
             bail!(

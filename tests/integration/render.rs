@@ -167,6 +167,8 @@ fn plant_refuses_bad_inventories_and_ones_that_cannot_fit() {
             err.contains(expect),
             "{objects}: expected `{expect}` in: {err}"
         );
+        // The scratch files are the command's own business, not the user's inputs.
+        assert!(!err.contains(".bsa-new"), "{objects}: {err}");
     }
 }
 
@@ -214,6 +216,8 @@ fn new_refuses_pictures_objects_and_options_it_cannot_use() {
             "no dark pixel",
         ),
         (m, "sphere:5", vec![], "larger than the"),
+        (m, "sphere:1e-9", vec![], "less than one pixel"),
+        (m, "mesh:Cargo.toml", vec![], "--objects: mesh:"),
         (m, "cube:1", vec![], "unknown kind `cube`"),
         (
             m,
