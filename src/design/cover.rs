@@ -467,6 +467,11 @@ impl<'a> Cover<'a> {
 
     /// Redraw the value and owner maps from every placement but `skip`.
     fn redraw(&mut self, skip: Option<usize>) {
+        self.redraw_but(&skip.into_iter().collect::<Vec<_>>());
+    }
+
+    /// Redraw the value and owner maps from every placement but those in `skip`.
+    fn redraw_but(&mut self, skip: &[usize]) {
         self.value = self
             .picture
             .on
@@ -475,7 +480,7 @@ impl<'a> Cover<'a> {
             .collect();
         self.owners.iter_mut().for_each(|o| *o = 0);
         for k in 0..self.placements.len() {
-            if Some(k) != skip {
+            if !skip.contains(&k) {
                 let p = self.placements[k].clone();
                 let pose = self.families[k].pose(p.alpha);
                 self.draw(k, &p, &pose);
@@ -521,6 +526,187 @@ impl<'a> Cover<'a> {
             }
         }
         self.redraw(None);
+    }
+
+    /// Undo the greedy's other short sight, which object goes where: for every two
+    /// placements of objects of different shapes (`same` tells identical ones), each
+    /// object is tried on the other's place (every pose family and roll of its own, the
+    /// other's direction either way round, the magnification that gives the other's
+    /// area, then refined) and the exchange is kept when the two gain more together.
+    /// Largest first, the greedy gives the largest object the place it covers best at
+    /// any magnification, which is often a smaller object's place (a king on the
+    /// queen's silhouette). `families[k]` are placement `k`'s object's pose families.
+    /// Returns the exchanges made.
+    pub fn exchange(
+        &mut self,
+        families: &[Vec<Family>],
+        same: &dyn Fn(usize, usize) -> bool,
+    ) -> usize {
+        let n = self.placements.len();
+        let mut made = 0;
+        for a in 0..n {
+            for b in a + 1..n {
+                if same(a, b) {
+                    continue;
+                }
+                let now = self.pair_gain(a, b);
+                let saved = (
+                    self.placements.clone(),
+                    self.families.clone(),
+                    self.heights.clone(),
+                );
+                let old_a = self.placements[a].clone();
+                let mut kept = false;
+                if let Some((pa, fa)) = self.placed_on(a, &families[a], b) {
+                    let gain_a = pa.gain;
+                    self.set(a, pa, fa);
+                    // `b` is off the picture while it looks for its new place.
+                    let hb = self.heights[b];
+                    self.heights[b] = (f64::NAN, 0.0);
+                    let found = self.placed_at(b, &families[b], &old_a);
+                    self.heights[b] = hb;
+                    if let Some((pb, fb)) = found {
+                        if gain_a + pb.gain > now + 1e-6 {
+                            self.set(b, pb, fb);
+                            kept = true;
+                            made += 1;
+                        }
+                    }
+                }
+                if !kept {
+                    (self.placements, self.families, self.heights) = saved;
+                }
+                self.redraw(None);
+            }
+        }
+        made
+    }
+
+    /// Placement `k` becomes `p` (its object kept) in pose family `family`.
+    fn set(&mut self, k: usize, p: Placement, family: Family) {
+        let pose = family.pose(p.alpha);
+        self.heights[k] = (self.frame.height(p.m), pose.half_height);
+        self.placements[k] = Placement {
+            object: self.placements[k].object,
+            ..p
+        };
+        self.families[k] = family;
+    }
+
+    /// The gain of placements `a` and `b` together, on the picture covered by all the
+    /// others (a first, then b on what a leaves). Leaves the maps drawn without `a` and
+    /// `b`.
+    fn pair_gain(&mut self, a: usize, b: usize) -> f64 {
+        self.redraw_but(&[a, b]);
+        let heights = self.heights.clone();
+        self.heights[a] = (f64::NAN, 0.0);
+        self.heights[b] = (f64::NAN, 0.0);
+        let ga = self.gain_of(a);
+        let pa = self.placements[a].clone();
+        let pose_a = self.families[a].pose(pa.alpha);
+        self.draw(a, &pa, &pose_a);
+        self.heights[a] = heights[a];
+        let gb = self.gain_of(b);
+        self.heights = heights;
+        self.redraw_but(&[a, b]);
+        match (ga, gb) {
+            (Some(x), Some(y)) => x + y,
+            _ => f64::NEG_INFINITY,
+        }
+    }
+
+    /// The gain of placement `k` as it stands, on the maps as they are.
+    fn gain_of(&self, k: usize) -> Option<f64> {
+        let p = &self.placements[k];
+        let pose = self.families[k].pose(p.alpha);
+        let c = Candidate {
+            centre: p.centre,
+            theta: p.theta,
+            m: p.m,
+            alpha: p.alpha,
+        };
+        self.score(&pose.outline.samples(FINE_SAMPLES), &c, pose.half_height)
+    }
+
+    /// Object `k` (with its pose `families`) placed where placement `on` is, the maps
+    /// drawn without `k` and `on` (as [`Cover::pair_gain`] leaves them): drawn there
+    /// when found. Returns the placement and its family.
+    fn placed_on(
+        &mut self,
+        k: usize,
+        families: &[Family],
+        on: usize,
+    ) -> Option<(Placement, Family)> {
+        let target = self.placements[on].clone();
+        let heights = self.heights.clone();
+        self.heights[k] = (f64::NAN, 0.0);
+        self.heights[on] = (f64::NAN, 0.0);
+        let found = self.placed_at(k, families, &target);
+        self.heights = heights;
+        let (p, fam) = found?;
+        let pose = fam.pose(p.alpha);
+        self.draw(k, &p, &pose);
+        Some((p, fam))
+    }
+
+    /// The best placement of object `k` (with its pose `families`) at `spot`'s place:
+    /// started from every family and roll, `spot`'s direction either way round and the
+    /// magnification of `spot`'s area, the best start refined. The maps are not changed.
+    fn placed_at(
+        &self,
+        k: usize,
+        families: &[Family],
+        spot: &Placement,
+    ) -> Option<(Placement, Family)> {
+        let mpp = self.frame.metres_per_px;
+        let mut starts: Vec<(f64, usize, Candidate)> = Vec::new();
+        for (fi, fam) in families.iter().enumerate() {
+            for alpha in fam.alphas() {
+                let pose = fam.pose(alpha);
+                let area = pose.outline.area();
+                if area <= 0.0 {
+                    continue;
+                }
+                let m = (spot.area / area).sqrt() * mpp;
+                let m = m.clamp(self.frame.m_lo, self.frame.m_hi);
+                let samples = pose.outline.samples(COARSE_SAMPLES);
+                for turn in [0.0, std::f64::consts::PI] {
+                    let c = Candidate {
+                        centre: spot.centre,
+                        theta: spot.theta + turn,
+                        m,
+                        alpha,
+                    };
+                    if let Some(g) = self.score(&samples, &c, pose.half_height) {
+                        starts.push((g, fi, c));
+                    }
+                }
+            }
+        }
+        starts.sort_by(|x, y| y.0.total_cmp(&x.0));
+        let mut best: Option<(f64, usize, Candidate)> = None;
+        for &(_, fi, c) in starts.iter().take(2) {
+            let (g, c) = self.refine(&families[fi], c);
+            if g.is_finite() && best.as_ref().is_none_or(|b| g > b.0) {
+                best = Some((g, fi, c));
+            }
+        }
+        let (gain, fi, c) = best?;
+        let pose = families[fi].pose(c.alpha);
+        let scale = c.m / mpp;
+        Some((
+            Placement {
+                object: k,
+                family: fi,
+                alpha: c.alpha,
+                centre: c.centre,
+                theta: c.theta,
+                m: c.m,
+                gain,
+                area: pose.outline.area() * scale * scale,
+            },
+            families[fi].clone(),
+        ))
     }
 
     fn draw(&mut self, index: usize, p: &Placement, pose: &Pose) {
@@ -673,6 +859,64 @@ mod tests {
             b.theta
         );
         assert!(cover.open() < 2000, "{} target pixels left", cover.open());
+    }
+
+    #[test]
+    fn objects_on_each_others_places_are_exchanged() {
+        // A square of 100 px and a bar of 150 x 50 px at 5 mm per pixel; a block of
+        // 0.3 x 0.1 x 0.05 m placed on the square and a cube of 0.1 m on the bar (as the
+        // greedy pass leaves chess pieces of similar sizes when the largest takes the
+        // place it covers most). Exchanged, the block lies along the bar and the cube
+        // fills the square.
+        let pic = picture(320, 240, &[(40, 70, 140, 170), (170, 95, 320, 145)]);
+        let frame = Frame::new(0.005, 6.0, 0.8);
+        let big = families(&Shape::Cuboid {
+            half_extents: DVec3::new(0.15, 0.05, 0.025),
+        });
+        let cube = families(&Shape::Cuboid {
+            half_extents: DVec3::splat(0.05),
+        });
+        let mut cover = Cover::new(&pic, frame);
+        for (k, fams, centre, m) in [
+            (0, &big, DVec2::new(90.0, 120.0), 1.7),
+            (1, &cube, DVec2::new(245.0, 120.0), 2.5),
+        ] {
+            let pose = fams[0].pose(0.0);
+            let scale = m / 0.005;
+            let p = Placement {
+                object: k,
+                family: 0,
+                alpha: 0.0,
+                centre,
+                theta: 0.0,
+                m,
+                gain: 0.0,
+                area: pose.outline.area() * scale * scale,
+            };
+            cover.commit(p, fams[0].clone());
+        }
+        let on_square = |p: &Placement| p.centre.x < 155.0;
+        let before = cover.open();
+        let made = cover.exchange(&[big.clone(), cube.clone()], &|_, _| false);
+        assert_eq!(made, 1);
+        assert!(!on_square(&cover.placements[0]) && on_square(&cover.placements[1]));
+        // The objects keep their indices, and the cover gained.
+        assert_eq!(
+            (cover.placements[0].object, cover.placements[1].object),
+            (0, 1)
+        );
+        assert!(
+            cover.open() + 5000 < before,
+            "{} open after, {before} before",
+            cover.open()
+        );
+        // Objects of the same shape are never exchanged, and a second round finds
+        // nothing more.
+        assert_eq!(
+            cover.exchange(&[big.clone(), cube.clone()], &|_, _| true),
+            0
+        );
+        assert_eq!(cover.exchange(&[big, cube], &|_, _| false), 0);
     }
 
     #[test]

@@ -4,7 +4,8 @@
 //! built-in [`chess`] set), [`picture`] (distance transform, ridge and local direction
 //! of the target), [`pose`] (how each object can be posed at `t` and its top view),
 //! [`cover`] (the greedy cover of the picture by the objects' shadows, with heights
-//! apart where shadows touch), [`launch`] (poses at `t`, slots on the table, start
+//! apart where shadows touch, then objects of different shapes exchanged where both
+//! fit better), [`launch`] (poses at `t`, slots on the table, start
 //! velocities and spins, hints and the scene file), [`assign`] (slots by least total
 //! distance), [`separate`] (the start guess made contact-free with the exact contact
 //! search). The method is documented in `docs/design.md`.
@@ -64,6 +65,11 @@ pub const CEILINGS: [f64; 4] = [0.8, 0.7, 0.6, 0.5];
 
 /// Rounds of [`Cover::polish`] after the greedy pass.
 pub const POLISH_ROUNDS: usize = 2;
+
+/// Rounds of [`Cover::exchange`] after the greedy pass, at most (they stop at the first
+/// that exchanges nothing): an object that is on a third object's place reaches its
+/// own through two exchanges.
+pub const EXCHANGE_ROUNDS: usize = 4;
 
 /// Why a picture cannot be designed.
 #[derive(Debug, thiserror::Error)]
@@ -147,6 +153,22 @@ pub fn design(
     }
     if objects.is_empty() {
         return Err(DesignError::NothingWorthIt);
+    }
+    // Which object goes where, reconsidered (see `Cover::exchange`).
+    let fams: Vec<Vec<pose::Family>> = cover
+        .placements
+        .iter()
+        .map(|p| objects[p.object].families())
+        .collect();
+    let shapes: Vec<&crate::geometry::shape::Shape> = cover
+        .placements
+        .iter()
+        .map(|p| &objects[p.object].shape)
+        .collect();
+    for _ in 0..EXCHANGE_ROUNDS {
+        if cover.exchange(&fams, &|a, b| shapes[a] == shapes[b]) == 0 {
+            break;
+        }
     }
     cover.polish(POLISH_ROUNDS);
     Ok(Plan::new(geometry, objects, cover.placements))
