@@ -116,6 +116,9 @@ pub struct Cover<'a> {
     value: Vec<f32>,
     /// Bit k: placement k's shadow is on (or near) this pixel.
     owners: Vec<u64>,
+    /// Bit k: placement k's shadow is on this pixel (so that one placement can be lifted
+    /// off without redrawing the others).
+    covers: Vec<u64>,
     /// Height and half height of every placement so far.
     heights: Vec<(f64, f64)>,
     /// The pose family of every placement.
@@ -144,6 +147,7 @@ impl<'a> Cover<'a> {
             frame,
             value,
             owners: vec![0; picture.on.len()],
+            covers: vec![0; picture.on.len()],
             heights: Vec::new(),
             families: Vec::new(),
             placements: Vec::new(),
@@ -479,6 +483,7 @@ impl<'a> Cover<'a> {
             .map(|&b| if b { 1.0 } else { -1.0 })
             .collect();
         self.owners.iter_mut().for_each(|o| *o = 0);
+        self.covers.iter_mut().for_each(|o| *o = 0);
         for k in 0..self.placements.len() {
             if !skip.contains(&k) {
                 let p = self.placements[k].clone();
@@ -549,6 +554,8 @@ impl<'a> Cover<'a> {
                 if same(a, b) {
                     continue;
                 }
+                self.show(a, false);
+                self.show(b, false);
                 let now = self.pair_gain(a, b);
                 let saved = (
                     self.placements.clone(),
@@ -560,6 +567,7 @@ impl<'a> Cover<'a> {
                 if let Some((pa, fa)) = self.placed_on(a, &families[a], b) {
                     let gain_a = pa.gain;
                     self.set(a, pa, fa);
+                    self.show(a, true);
                     // `b` is off the picture while it looks for its new place.
                     let hb = self.heights[b];
                     self.heights[b] = (f64::NAN, 0.0);
@@ -572,11 +580,17 @@ impl<'a> Cover<'a> {
                             made += 1;
                         }
                     }
+                    if !kept {
+                        self.show(a, false);
+                    }
                 }
-                if !kept {
+                if kept {
+                    self.show(b, true);
+                } else {
                     (self.placements, self.families, self.heights) = saved;
+                    self.show(a, true);
+                    self.show(b, true);
                 }
-                self.redraw(None);
             }
         }
         made
@@ -594,21 +608,18 @@ impl<'a> Cover<'a> {
     }
 
     /// The gain of placements `a` and `b` together, on the picture covered by all the
-    /// others (a first, then b on what a leaves). Leaves the maps drawn without `a` and
-    /// `b`.
+    /// others (a first, then b on what a leaves); the maps are drawn without `a` and `b`,
+    /// and left so.
     fn pair_gain(&mut self, a: usize, b: usize) -> f64 {
-        self.redraw_but(&[a, b]);
         let heights = self.heights.clone();
         self.heights[a] = (f64::NAN, 0.0);
         self.heights[b] = (f64::NAN, 0.0);
         let ga = self.gain_of(a);
-        let pa = self.placements[a].clone();
-        let pose_a = self.families[a].pose(pa.alpha);
-        self.draw(a, &pa, &pose_a);
+        self.show(a, true);
         self.heights[a] = heights[a];
         let gb = self.gain_of(b);
+        self.show(a, false);
         self.heights = heights;
-        self.redraw_but(&[a, b]);
         match (ga, gb) {
             (Some(x), Some(y)) => x + y,
             _ => f64::NEG_INFINITY,
@@ -628,9 +639,9 @@ impl<'a> Cover<'a> {
         self.score(&pose.outline.samples(FINE_SAMPLES), &c, pose.half_height)
     }
 
-    /// Object `k` (with its pose `families`) placed where placement `on` is, the maps
-    /// drawn without `k` and `on` (as [`Cover::pair_gain`] leaves them): drawn there
-    /// when found. Returns the placement and its family.
+    /// Object `k` (with its pose `families`) placed where placement `on` is, on the maps
+    /// drawn without `k` and `on`, neither of which constrains its height. Returns the
+    /// placement and its family; the maps are not changed.
     fn placed_on(
         &mut self,
         k: usize,
@@ -643,10 +654,7 @@ impl<'a> Cover<'a> {
         self.heights[on] = (f64::NAN, 0.0);
         let found = self.placed_at(k, families, &target);
         self.heights = heights;
-        let (p, fam) = found?;
-        let pose = fam.pose(p.alpha);
-        self.draw(k, &p, &pose);
-        Some((p, fam))
+        found
     }
 
     /// The best placement of object `k` (with its pose `families`) at `spot`'s place:
@@ -709,7 +717,9 @@ impl<'a> Cover<'a> {
         ))
     }
 
-    fn draw(&mut self, index: usize, p: &Placement, pose: &Pose) {
+    /// The pixels (x0..x1, y0..y1) a placement's shadow, or the ring near it, may reach;
+    /// and that ring's offsets (outline units).
+    fn reach(&self, p: &Placement, pose: &Pose) -> ((usize, usize, usize, usize), Vec<DVec2>) {
         let (w, h) = (self.picture.width, self.picture.height);
         let scale = p.m / self.frame.metres_per_px;
         let near = (NEAR_M * scale).ceil();
@@ -723,13 +733,20 @@ impl<'a> Cover<'a> {
             (p.centre.y - reach).floor().max(0.0) as usize,
             ((p.centre.y + reach).ceil() as usize).min(h),
         );
-        let bit = 1u64 << (index % 64);
         let rings: Vec<DVec2> = (0..8)
             .map(|k| {
                 let a = k as f64 * std::f64::consts::FRAC_PI_4;
                 DVec2::new(a.cos(), a.sin()) * (near / scale)
             })
             .collect();
+        ((x0, x1, y0, y1), rings)
+    }
+
+    fn draw(&mut self, index: usize, p: &Placement, pose: &Pose) {
+        let w = self.picture.width;
+        let scale = p.m / self.frame.metres_per_px;
+        let ((x0, x1, y0, y1), rings) = self.reach(p, pose);
+        let bit = 1u64 << (index % 64);
         for y in y0..y1 {
             for x in x0..x1 {
                 let d = from_pixel(
@@ -742,10 +759,42 @@ impl<'a> Cover<'a> {
                 if pose.outline.contains(d) {
                     self.value[k] = 0.0;
                     self.owners[k] |= bit;
+                    self.covers[k] |= bit;
                 } else if rings.iter().any(|r| pose.outline.contains(d + *r)) {
                     self.owners[k] |= bit;
                 }
             }
+        }
+    }
+
+    /// Lift placement `index` (drawn as `p` in `pose`) off the maps: they become what
+    /// [`Cover::redraw_but`] would draw without it.
+    fn undraw(&mut self, index: usize, p: &Placement, pose: &Pose) {
+        let w = self.picture.width;
+        let ((x0, x1, y0, y1), _) = self.reach(p, pose);
+        let bit = 1u64 << (index % 64);
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let k = y * w + x;
+                self.owners[k] &= !bit;
+                if self.covers[k] & bit != 0 {
+                    self.covers[k] &= !bit;
+                    if self.covers[k] == 0 {
+                        self.value[k] = if self.picture.on[k] { 1.0 } else { -1.0 };
+                    }
+                }
+            }
+        }
+    }
+
+    /// [`Cover::draw`] or [`Cover::undraw`] placement `k` as it stands.
+    fn show(&mut self, k: usize, on: bool) {
+        let p = self.placements[k].clone();
+        let pose = self.families[k].pose(p.alpha);
+        if on {
+            self.draw(k, &p, &pose);
+        } else {
+            self.undraw(k, &p, &pose);
         }
     }
 }
