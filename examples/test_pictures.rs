@@ -4,7 +4,7 @@
 //! (DejaVu Sans's airplane, chess knight and umbrella symbols), 640 x 480, black on
 //! white, each with the box of objects it is to be made of, stated before any solve.
 //!
-//! Three sets: set 1 (`tools/test-pictures`), the pictures `bsa new` was developed on;
+//! Eight sets: set 1 (`tools/test-pictures`), the pictures `bsa new` was developed on;
 //! set 2 (`tools/test-pictures-2`), drawn after the code was final and solved once, for
 //! the figures of the issue: letters, digits, outlines, a filled star, a snowman of
 //! discs and two DejaVu symbols (heart and spade) as silhouettes; set 3
@@ -20,9 +20,12 @@
 //! zigzag, two discs, and the beamed notes and anchor symbols); set 7
 //! (`tools/test-pictures-7`), drawn after that session's last code change (lowercase a,
 //! e, f, r, u, w, the letter I, percent and question marks, a staircase, three discs in
-//! a row, and the scissors and sun symbols).
+//! a row, and the scissors and sun symbols); set 8 (`tools/test-pictures-8`), drawn
+//! after a later session's last design change (lowercase b, d, g, m, p, s, l, the
+//! less-than and ampersand signs, a window of bars, a caterpillar of discs, and the
+//! flag and eighth-note symbols), with generous boxes of objects.
 //!
-//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 7,
+//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 8,
 //! default 1; DIR default `tools/test-pictures[-SET]`): writes
 //! `DIR/<name>.png` and `DIR/manifest.tsv` (name, objects, extra `bsa new` options),
 //! which `scripts/new-suite.sh` reads. The output depends only on the font file and
@@ -220,6 +223,51 @@ fn steps(x: f64, y: f64) -> bool {
 fn trio(x: f64, y: f64) -> bool {
     // Three discs in a row, the middle one largest, apart.
     (x + 150.0).hypot(y) <= 55.0 || x.hypot(y) <= 75.0 || (x - 150.0).hypot(y) <= 55.0
+}
+
+fn window(x: f64, y: f64) -> bool {
+    // A square frame 220 wide with bars 36 wide, and a cross of two bars 36 wide
+    // through its middle.
+    let (ax, ay) = (x.abs(), y.abs());
+    ax <= 110.0 && ay <= 110.0 && (ax >= 74.0 || ay >= 74.0 || ax <= 18.0 || ay <= 18.0)
+}
+
+fn caterpillar(x: f64, y: f64) -> bool {
+    // Five discs of radius 34 along an arch, apart.
+    (0..5).any(|k| {
+        let a = std::f64::consts::PI * (0.15 + 0.175 * k as f64);
+        let (cx, cy) = (-190.0 * a.cos(), 110.0 * a.sin() - 50.0);
+        (x - cx).hypot(y - cy) <= 34.0
+    })
+}
+
+/// Set 8: defined in a later session after its last change to the design (the
+/// exchange of places), its objects stated with it (generously: the objects an artist
+/// would bring for each picture, more than the lean boxes of sets 5 to 7), and run once.
+fn pictures_8() -> Vec<(&'static str, Shape, String, &'static str)> {
+    let chess_stage = "--width 0.96 --light-height 3";
+    let glyph = |name, c, objects: String| (name, Shape::Glyph(c, 6), objects, "");
+    let chess = |name, c| (name, Shape::Glyph(c, 0), "chess".to_string(), chess_stage);
+    vec![
+        glyph("small-b", 'b', format!("{DOUBLE},{UNIT}*5")),
+        glyph("small-d", 'd', format!("{DOUBLE},{UNIT}*5")),
+        glyph("small-g", 'g', format!("{DOUBLE},{UNIT}*6")),
+        glyph("small-m", 'm', format!("{UNIT}*8")),
+        glyph("small-p", 'p', format!("{DOUBLE},{UNIT}*5")),
+        glyph("small-s", 's', format!("{UNIT}*7")),
+        glyph("small-l", 'l', DOUBLE.to_string()),
+        glyph("less-than", '<', format!("{DOUBLE}*2")),
+        glyph("ampersand", '&', format!("{UNIT}*8,{HALF}*2")),
+        ("window", Shape::Drawn(window), format!("{DOUBLE}*6"), ""),
+        (
+            "caterpillar",
+            Shape::Drawn(caterpillar),
+            "sphere:0.07*5".to_string(),
+            "",
+        ),
+        glyph("flag", '\u{2691}', format!("{DOUBLE},{UNIT}*4")),
+        chess("note", '\u{266A}'),
+    ]
 }
 
 /// Set 7: defined in a later session after its last code change (its objects stated
@@ -688,7 +736,8 @@ fn main() -> Result<(), Box<dyn Error>> {
         "5" => (pictures_5(), "tools/test-pictures-5"),
         "6" => (pictures_6(), "tools/test-pictures-6"),
         "7" => (pictures_7(), "tools/test-pictures-7"),
-        other => return Err(format!("SET must be 1 to 7, got {other:?}").into()),
+        "8" => (pictures_8(), "tools/test-pictures-8"),
+        other => return Err(format!("SET must be 1 to 8, got {other:?}").into()),
     };
     let dir = args
         .get(1)
