@@ -136,6 +136,29 @@ struct Candidate {
 }
 
 impl<'a> Cover<'a> {
+    /// The placement of object `object` at candidate `c` in pose family `family` (whose
+    /// pose at `c`'s roll is `pose`), gaining `gain`.
+    fn placement(
+        &self,
+        object: usize,
+        family: usize,
+        pose: &Pose,
+        c: Candidate,
+        gain: f64,
+    ) -> Placement {
+        let scale = c.m / self.frame.metres_per_px;
+        Placement {
+            object,
+            family,
+            alpha: c.alpha,
+            centre: c.centre,
+            theta: c.theta,
+            m: c.m,
+            gain,
+            area: pose.outline.area() * scale * scale,
+        }
+    }
+
     pub fn new(picture: &'a Picture, frame: Frame) -> Cover<'a> {
         let value = picture
             .on
@@ -265,17 +288,7 @@ impl<'a> Cover<'a> {
         }
         let (gain, family, c) = best?;
         let pose = families[family].pose(c.alpha);
-        let scale = c.m / self.frame.metres_per_px;
-        Some(Placement {
-            object,
-            family,
-            alpha: c.alpha,
-            centre: c.centre,
-            theta: c.theta,
-            m: c.m,
-            gain,
-            area: pose.outline.area() * scale * scale,
-        })
+        Some(self.placement(object, family, &pose, c, gain))
     }
 
     /// The sphere that gains most, for `auto:sphere`: centred on the ridge of the target
@@ -516,16 +529,7 @@ impl<'a> Cover<'a> {
                 self.heights = heights;
                 if gain.is_finite() {
                     let pose = self.families[k].pose(c.alpha);
-                    let scale = c.m / self.frame.metres_per_px;
-                    self.placements[k] = Placement {
-                        alpha: c.alpha,
-                        centre: c.centre,
-                        theta: c.theta,
-                        m: c.m,
-                        gain,
-                        area: pose.outline.area() * scale * scale,
-                        ..p
-                    };
+                    self.placements[k] = self.placement(p.object, p.family, &pose, c, gain);
                     self.heights[k] = (self.frame.height(c.m), pose.half_height);
                 }
             }
@@ -701,20 +705,7 @@ impl<'a> Cover<'a> {
         }
         let (gain, fi, c) = best?;
         let pose = families[fi].pose(c.alpha);
-        let scale = c.m / mpp;
-        Some((
-            Placement {
-                object: k,
-                family: fi,
-                alpha: c.alpha,
-                centre: c.centre,
-                theta: c.theta,
-                m: c.m,
-                gain,
-                area: pose.outline.area() * scale * scale,
-            },
-            families[fi].clone(),
-        ))
+        Some((self.placement(k, fi, &pose, c, gain), families[fi].clone()))
     }
 
     /// The pixels (x0..x1, y0..y1) a placement's shadow, or the ring near it, may reach;

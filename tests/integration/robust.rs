@@ -209,6 +209,25 @@ fn leftover_temporaries(out: &Path) -> Vec<String> {
         .collect()
 }
 
+/// `bsa ARGS` started in the repository, its stderr piped.
+fn spawn(args: &[&str]) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_bsa"))
+        .args(args)
+        .current_dir(root())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Wait (a minute at most) until `file` exists.
+fn wait_for(file: &Path) {
+    let start = Instant::now();
+    while !file.exists() && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
 #[test]
 fn an_interrupted_solve_keeps_the_previous_complete_solution() {
     let (quick, slow) = quick_and_slow("interrupt");
@@ -217,27 +236,18 @@ fn an_interrupted_solve_keeps_the_previous_complete_solution() {
     assert!(ok, "{err}");
     let before = std::fs::read(out.join("solution.json")).unwrap();
 
-    let child = Command::new(env!("CARGO_BIN_EXE_bsa"))
-        .args([
-            "solve",
-            slow.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--quiet",
-            // Another scene file than the one the folder holds: replacing it is meant.
-            "--force",
-        ])
-        .current_dir(root())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let child = spawn(&[
+        "solve",
+        slow.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        // Another scene file than the one the folder holds: replacing it is meant.
+        "--force",
+    ]);
     // Once the previous solution is set aside the solve is under way; give it time to
     // install its signal handler and start the first stage.
-    let start = Instant::now();
-    while !out.join("solution.prev.json").exists() && start.elapsed() < Duration::from_secs(60) {
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    wait_for(&out.join("solution.prev.json"));
     std::thread::sleep(Duration::from_millis(500));
     // SIGTERM twice, handled like two presses of Ctrl-C.
     for _ in 0..2 {
@@ -494,31 +504,21 @@ fn new_refusing_its_input_leaves_the_folders_scene_as_it_was() {
 fn an_interrupted_new_writes_nothing_and_leaves_no_scratch_files() {
     let (dir, scene, target) = folder_with_a_scene("new-interrupted");
     let thinker = root().join("scenes/thinker/target.png");
-    let child = Command::new(env!("CARGO_BIN_EXE_bsa"))
-        .args([
-            "new",
-            dir.to_str().unwrap(),
-            "--target",
-            thinker.to_str().unwrap(),
-            "--objects",
-            "chess",
-            "--width",
-            "0.96",
-            "--light-height",
-            "3",
-        ])
-        .current_dir(root())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let child = spawn(&[
+        "new",
+        dir.to_str().unwrap(),
+        "--target",
+        thinker.to_str().unwrap(),
+        "--objects",
+        "chess",
+        "--width",
+        "0.96",
+        "--light-height",
+        "3",
+    ]);
     // Once a design's scratch scene exists, the designs and their trial solves are under
     // way (they take seconds for sixteen pieces).
-    let start = Instant::now();
-    while !dir.join(".bsa-new-design-0.json").exists() && start.elapsed() < Duration::from_secs(60)
-    {
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    wait_for(&dir.join(".bsa-new-design-0.json"));
     std::thread::sleep(Duration::from_millis(200));
     let _ = Command::new("kill")
         .args(["-TERM", &child.id().to_string()])
