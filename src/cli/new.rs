@@ -90,6 +90,38 @@ struct Prototype {
     density: f64,
 }
 
+impl Prototype {
+    /// The object as the user's list names it: `sphere:R`, `box:XxYxZ`, `mesh:FILE`,
+    /// or the chess piece.
+    fn describe(&self) -> String {
+        let number = |v: &Value| v.as_f64().map_or("?".to_string(), |x| format!("{x}"));
+        if let Some(r) = self.shape.get("sphere").and_then(|s| s.get("radius")) {
+            return format!("sphere:{}", number(r));
+        }
+        if let Some(size) = self.shape.get("box").and_then(|b| b.get("size")) {
+            let parts: Vec<String> = size
+                .as_array()
+                .map_or(Vec::new(), |a| a.iter().map(number).collect());
+            return format!("box:{}", parts.join("x"));
+        }
+        match self
+            .shape
+            .get("mesh")
+            .and_then(|m| m.get("obj"))
+            .and_then(Value::as_str)
+        {
+            Some(obj) if obj.starts_with("pieces/") && self.stem != "mesh" => {
+                format!("the chess {}", self.stem)
+            }
+            Some(obj) => match self.shape["mesh"].get("scale").and_then(Value::as_f64) {
+                Some(scale) if scale != 1.0 => format!("mesh:{obj}@{scale}"),
+                _ => format!("mesh:{obj}"),
+            },
+            None => self.stem.clone(),
+        }
+    }
+}
+
 /// The scene file's shape of a kind (chess pieces are written beside the scene).
 fn prototype(dir: &Path, kind: &Kind, density: f64) -> Result<Prototype> {
     let (stem, shape) = match kind {
@@ -251,7 +283,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     }
     write(&probe_file, &probe)?;
     let scene = load::scene(&probe_file).map_err(|e| in_users_terms(e, &opts.target, &protos))?;
-    check_sizes(&scene, protos.len())?;
+    check_sizes(&scene, &protos)?;
     let objects: Vec<Object> = protos
         .iter()
         .zip(&scene.occluders)
@@ -517,16 +549,7 @@ fn in_users_terms(err: anyhow::Error, target: &Path, protos: &[Prototype]) -> an
             .next()?
             .parse()
             .ok()?;
-        let p = protos.get(k)?;
-        Some(match p.shape.get("mesh").and_then(|m| m.get("obj")) {
-            Some(obj)
-                if p.stem != "mesh" && obj.as_str().is_some_and(|o| o.starts_with("pieces/")) =>
-            {
-                format!("the chess {}", p.stem)
-            }
-            Some(obj) => format!("mesh:{}", obj.as_str().unwrap_or("?")),
-            None => format!("the {} {}", p.stem, p.shape),
-        })
+        protos.get(k).map(Prototype::describe)
     };
     match err.downcast_ref::<SceneError>() {
         Some(SceneError::TargetEmpty { .. }) => anyhow::anyhow!(
@@ -549,17 +572,17 @@ fn in_users_terms(err: anyhow::Error, target: &Path, protos: &[Prototype]) -> an
 
 /// An object whose shadow is wider than the picture cannot be part of it; one whose
 /// shadow is smaller than a pixel even at the highest ceiling cannot be seen in it.
-fn check_sizes(scene: &Scene, count: usize) -> Result<()> {
+fn check_sizes(scene: &Scene, protos: &[Prototype]) -> Result<()> {
     let pixel = scene.receiver.width / scene.target.width() as f64;
     // A body under the highest ceiling, a share c of the light's height above the
     // picture, casts a shadow 1 / (1 - c) times its size.
     let magnified = 1.0 / (1.0 - design::CEILINGS[0]);
-    for o in scene.occluders.iter().take(count) {
+    for (o, p) in scene.occluders.iter().zip(protos) {
         let most = 2.0 * o.bounding_radius * magnified;
         if most < pixel {
             bail!(
-                "object `{}` ({:.2e} m across) casts a shadow of at most {:.2e} m, less than one pixel ({:.2e} m) of the {:.2} m wide picture: use larger objects or a narrower picture (--width)",
-                o.name,
+                "--objects: {} ({:.2e} m across) casts a shadow of at most {:.2e} m, less than one pixel ({:.2e} m) of the {:.2} m wide picture: use larger objects or a narrower picture (--width)",
+                p.describe(),
                 2.0 * o.bounding_radius,
                 most,
                 pixel,
@@ -569,8 +592,8 @@ fn check_sizes(scene: &Scene, count: usize) -> Result<()> {
         let shadow = 2.0 * o.bounding_radius * 1.5;
         if shadow > scene.receiver.width.min(scene.receiver.height) {
             bail!(
-                "object `{}` ({:.3} m across) casts a shadow of about {:.2} m, larger than the {:.2} x {:.2} m picture: use a wider picture (--width) or smaller objects",
-                o.name,
+                "--objects: {} ({:.3} m across) casts a shadow of about {:.2} m, larger than the {:.2} x {:.2} m picture: use a wider picture (--width) or smaller objects",
+                p.describe(),
                 2.0 * o.bounding_radius,
                 shadow,
                 scene.receiver.width,

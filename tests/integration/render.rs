@@ -215,7 +215,12 @@ fn new_refuses_pictures_objects_and_options_it_cannot_use() {
             vec![],
             "no dark pixel",
         ),
-        (m, "sphere:5", vec![], "larger than the"),
+        (
+            m,
+            "sphere:5",
+            vec![],
+            "--objects: sphere:5 (10.000 m across)",
+        ),
         (m, "sphere:1e-9", vec![], "less than one pixel"),
         (m, "mesh:Cargo.toml", vec![], "--objects: mesh:"),
         (m, "cube:1", vec![], "unknown kind `cube`"),
