@@ -506,6 +506,21 @@ impl<'a> Cover<'a> {
         }
     }
 
+    /// Take placements `ks` out of the height rule (a placement looking for its place is
+    /// no obstacle to itself); their heights are returned for [`Cover::put_back`].
+    fn lift_heights(&mut self, ks: &[usize]) -> Vec<(usize, (f64, f64))> {
+        ks.iter()
+            .map(|&k| (k, std::mem::replace(&mut self.heights[k], (f64::NAN, 0.0))))
+            .collect()
+    }
+
+    /// Put back heights that [`Cover::lift_heights`] took out.
+    fn put_back(&mut self, lifted: Vec<(usize, (f64, f64))>) {
+        for (k, h) in lifted {
+            self.heights[k] = h;
+        }
+    }
+
     /// Undo the greedy's short sight: `rounds` times, each placement in turn is lifted
     /// off and refined (pattern search from where it is) against all the others. An
     /// early placement can then give up what a later one covers better (a wide shadow
@@ -515,10 +530,7 @@ impl<'a> Cover<'a> {
             for k in 0..self.placements.len() {
                 self.redraw(Some(k));
                 let p = self.placements[k].clone();
-                let heights = std::mem::take(&mut self.heights);
-                // The placement's own height is not a constraint on itself.
-                self.heights = heights.clone();
-                self.heights[k] = (f64::NAN, 0.0);
+                let lifted = self.lift_heights(&[k]);
                 let c = Candidate {
                     centre: p.centre,
                     theta: p.theta,
@@ -526,7 +538,7 @@ impl<'a> Cover<'a> {
                     alpha: p.alpha,
                 };
                 let (gain, c) = self.refine(&self.families[k].clone(), c);
-                self.heights = heights;
+                self.put_back(lifted);
                 if gain.is_finite() {
                     let pose = self.families[k].pose(c.alpha);
                     self.placements[k] = self.placement(p.object, p.family, &pose, c, gain);
@@ -561,11 +573,13 @@ impl<'a> Cover<'a> {
                 self.show(a, false);
                 self.show(b, false);
                 let now = self.pair_gain(a, b);
-                let saved = (
-                    self.placements.clone(),
-                    self.families.clone(),
-                    self.heights.clone(),
-                );
+                let saved = [a, b].map(|k| {
+                    (
+                        self.placements[k].clone(),
+                        self.families[k].clone(),
+                        self.heights[k],
+                    )
+                });
                 let old_a = self.placements[a].clone();
                 let mut kept = false;
                 if let Some((pa, fa)) = self.placed_on(a, &families[a], b) {
@@ -573,10 +587,9 @@ impl<'a> Cover<'a> {
                     self.set(a, pa, fa);
                     self.show(a, true);
                     // `b` is off the picture while it looks for its new place.
-                    let hb = self.heights[b];
-                    self.heights[b] = (f64::NAN, 0.0);
+                    let lifted = self.lift_heights(&[b]);
                     let found = self.placed_at(b, &families[b], &old_a);
-                    self.heights[b] = hb;
+                    self.put_back(lifted);
                     if let Some((pb, fb)) = found {
                         if gain_a + pb.gain > now + 1e-6 {
                             self.set(b, pb, fb);
@@ -591,7 +604,9 @@ impl<'a> Cover<'a> {
                 if kept {
                     self.show(b, true);
                 } else {
-                    (self.placements, self.families, self.heights) = saved;
+                    for (k, (p, f, h)) in [a, b].into_iter().zip(saved) {
+                        (self.placements[k], self.families[k], self.heights[k]) = (p, f, h);
+                    }
                     self.show(a, true);
                     self.show(b, true);
                 }
@@ -615,15 +630,14 @@ impl<'a> Cover<'a> {
     /// others (a first, then b on what a leaves); the maps are drawn without `a` and `b`,
     /// and left so.
     fn pair_gain(&mut self, a: usize, b: usize) -> f64 {
-        let heights = self.heights.clone();
-        self.heights[a] = (f64::NAN, 0.0);
-        self.heights[b] = (f64::NAN, 0.0);
+        let lifted = self.lift_heights(&[a, b]);
         let ga = self.gain_of(a);
         self.show(a, true);
-        self.heights[a] = heights[a];
+        // `b` is placed against `a` as it stands: `a`'s height counts again.
+        self.heights[a] = lifted[0].1;
         let gb = self.gain_of(b);
         self.show(a, false);
-        self.heights = heights;
+        self.put_back(lifted);
         match (ga, gb) {
             (Some(x), Some(y)) => x + y,
             _ => f64::NEG_INFINITY,
@@ -653,11 +667,9 @@ impl<'a> Cover<'a> {
         on: usize,
     ) -> Option<(Placement, Family)> {
         let target = self.placements[on].clone();
-        let heights = self.heights.clone();
-        self.heights[k] = (f64::NAN, 0.0);
-        self.heights[on] = (f64::NAN, 0.0);
+        let lifted = self.lift_heights(&[k, on]);
         let found = self.placed_at(k, families, &target);
-        self.heights = heights;
+        self.put_back(lifted);
         found
     }
 
