@@ -243,11 +243,12 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     };
     let dir = &opts.dir;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let probe_file = dir.join(SCRATCH_PROBE);
     let design_files: Vec<PathBuf> = (0..design::CEILINGS.len())
         .map(|k| dir.join(format!(".bsa-new-design-{k}.json")))
         .collect();
-    let mut scratch = Scratch::new(
-        [dir.join(SCRATCH_TARGET), dir.join(SCRATCH_PROBE)]
+    let scratch = Scratch::new(
+        [dir.join(SCRATCH_TARGET), probe_file.clone()]
             .into_iter()
             .chain(design_files.iter().cloned())
             .collect(),
@@ -267,7 +268,6 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         .unwrap_or("scene")
         .to_string();
     let scene_file = dir.join("scene.json");
-    let probe_file = dir.join(SCRATCH_PROBE);
     let write = |file: &Path, json: &Value| -> Result<()> {
         files::write_atomic(file, serde_json::to_string_pretty(json)?.as_bytes())?;
         Ok(())
@@ -340,7 +340,6 @@ pub(super) fn run(opts: &Options) -> Result<()> {
                 opts.seed,
                 trial,
             );
-            let _ = std::fs::remove_file(file);
             bar.inc(1);
             variant
         })
@@ -379,8 +378,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         &scene_file,
         &plan.scene_json(&name, "target.png", opts.seed),
     )?;
-    scratch.written = true;
-    drop(scratch);
+    scratch.written();
     if trial {
         println!(
             "{name}: {}",

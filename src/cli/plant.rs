@@ -101,7 +101,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     // The draw works in scratch files: the folder's scene is replaced only once the new
     // one is complete (see `scratch`).
     let (scratch_target, scratch_scene) = (".bsa-plant-target.png", ".bsa-plant-scene.json");
-    let mut scratch = Scratch::new(vec![dir.join(scratch_target), dir.join(scratch_scene)], dir);
+    let scratch = Scratch::new(vec![dir.join(scratch_target), dir.join(scratch_scene)], dir);
     let write_scene =
         |file: &str, target: &str, hints: &[(usize, glam::DVec3, glam::DVec2)]| -> Result<()> {
             let json = layout.scene_json(&name, target, hints, opts.seed);
@@ -137,8 +137,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         &dir.join("planted.json"),
         serde_json::to_string_pretty(&launch)?.as_bytes(),
     )?;
-    scratch.written = true;
-    drop(scratch);
+    scratch.written();
     // The scene as a user gets it: loads, and its start guess aimed at the hints.
     let problem = Problem::new(load::scene(dir)?);
     let start = problem.evaluate(

@@ -13,8 +13,8 @@ pub(super) struct Scratch {
     pieces: PathBuf,
     /// The files `pieces/` held before, or `None` when it did not exist.
     pieces_before: Option<Vec<PathBuf>>,
-    /// Set once the scene is written: the pieces beside it stay.
-    pub(super) written: bool,
+    /// Set by [`Scratch::written`]: the pieces beside the scene stay.
+    written: bool,
 }
 
 impl Scratch {
@@ -28,6 +28,11 @@ impl Scratch {
             pieces_before,
             written: false,
         }
+    }
+
+    /// The scene is written: remove the scratch files now and keep the pieces beside it.
+    pub(super) fn written(mut self) {
+        self.written = true;
     }
 }
 
