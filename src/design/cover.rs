@@ -884,22 +884,31 @@ mod tests {
         assert!(p.gain > 0.9 * 12000.0, "gain {}", p.gain);
     }
 
+    /// The block's families that lie flat or stand (no pitch).
+    fn flat_block() -> Vec<Family> {
+        let mut f = block();
+        f.retain(|f| !matches!(f, Family::BoxTilted { .. }));
+        f
+    }
+
     #[test]
     fn touching_shadows_fly_apart_in_height() {
         // A cross of two bars: two blocks, one per bar, their heights at least the
-        // separation apart; and polishing keeps that.
+        // separation apart; and polishing keeps that. Flat blocks only: a pitched block
+        // covers the first bar's length at its width better, and flies so much taller
+        // that the second bar is left at a smaller magnification.
         let pic = picture(320, 240, &[(40, 100, 280, 140), (140, 10, 180, 230)]);
         let frame = Frame::new(0.0025, 6.0, 0.8);
         let mut cover = Cover::new(&pic, frame);
         for k in 0..2 {
-            let fams = block();
+            let fams = flat_block();
             let p = cover.best(k, &fams).unwrap();
             let f = fams[p.family].clone();
             cover.commit(p, f);
         }
         cover.polish(1);
         let [a, b] = [&cover.placements[0], &cover.placements[1]];
-        let pose = |p: &Placement| block()[p.family].pose(p.alpha);
+        let pose = |p: &Placement| flat_block()[p.family].pose(p.alpha);
         let need = separation(pose(a).half_height, pose(b).half_height);
         assert!((frame.height(a.m) - frame.height(b.m)).abs() >= need - 1e-9);
         // One bar each: their angles differ by a right angle.

@@ -18,6 +18,8 @@
 //! top view magnified by `m = H / (H - z)` about the point under the light, `z` being
 //! the height of the pose's centre (the middle of its bounding box).
 
+#[cfg(test)]
+use std::f64::consts::FRAC_PI_4;
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::sync::Arc;
 
@@ -34,6 +36,32 @@ pub enum Outline {
     Disc { r: f64 },
     /// Any shape, as occupied cells of a grid.
     Grid(Arc<Grid>),
+    /// A convex polygon, counter-clockwise (a tilted box's hexagon).
+    Polygon(Arc<Vec<DVec2>>),
+}
+
+/// The convex hull of `points`, counter-clockwise (Andrew's monotone chain).
+fn convex_hull(points: &[DVec2]) -> Vec<DVec2> {
+    let mut p: Vec<DVec2> = points.to_vec();
+    p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
+    let mut hull: Vec<DVec2> = Vec::with_capacity(2 * p.len());
+    for pass in 0..2 {
+        let start = hull.len();
+        for &q in p.iter() {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 1e-15
+            {
+                hull.pop();
+            }
+            hull.push(q);
+        }
+        hull.pop();
+        if pass == 0 {
+            p.reverse();
+        }
+    }
+    hull
 }
 
 /// Occupied cells of a square grid (metres).
@@ -115,6 +143,9 @@ impl Outline {
             Outline::Rect { len, wid } => d.x.abs() <= 0.5 * len && d.y.abs() <= 0.5 * wid,
             Outline::Disc { r } => d.length_squared() <= r * r,
             Outline::Grid(g) => g.contains(d),
+            Outline::Polygon(v) => {
+                (0..v.len()).all(|i| (v[(i + 1) % v.len()] - v[i]).perp_dot(d - v[i]) >= 0.0)
+            }
         }
     }
 
@@ -137,6 +168,7 @@ impl Outline {
                 }
                 (hi - lo) * 0.5
             }
+            Outline::Polygon(v) => v.iter().fold(DVec2::ZERO, |e, p| e.max(p.abs())),
         }
     }
 
@@ -146,7 +178,28 @@ impl Outline {
             Outline::Rect { len, wid } => len * wid,
             Outline::Disc { r } => PI * r * r,
             Outline::Grid(g) => g.on.iter().filter(|&&b| b).count() as f64 * g.cell * g.cell,
+            Outline::Polygon(v) => {
+                0.5 * (0..v.len())
+                    .map(|i| v[i].perp_dot(v[(i + 1) % v.len()]))
+                    .sum::<f64>()
+            }
         }
+    }
+
+    /// Whether `other` (in the same frame) shows nearly the same outline: at least 97 %
+    /// of the area of each lies inside the other.
+    pub fn matches(&self, other: &Outline) -> bool {
+        let inside = |a: &Outline, b: &Outline| {
+            let s = a.samples(500);
+            let total: f64 = s.iter().map(|(_, w)| w).sum();
+            let kept: f64 = s
+                .iter()
+                .filter(|(d, _)| b.contains(*d))
+                .map(|(_, w)| w)
+                .sum();
+            kept >= 0.97 * total
+        };
+        inside(self, other) && inside(other, self)
     }
 
     /// Whether every rotation about the centre shows the same outline.
@@ -172,6 +225,31 @@ impl Outline {
                     }
                 }
                 out
+            }
+            Outline::Polygon(_) => {
+                // Points of a grid over the bounding box that fall inside, each standing
+                // for an equal share of the area.
+                let e = self.half_extents();
+                let area = self.area();
+                let cell = (area / n as f64).sqrt().max(1e-9);
+                let (nx, ny) = (
+                    ((2.0 * e.x / cell).ceil() as usize).max(2),
+                    ((2.0 * e.y / cell).ceil() as usize).max(2),
+                );
+                let mut pts = Vec::new();
+                for j in 0..ny {
+                    for i in 0..nx {
+                        let p = DVec2::new(
+                            -e.x + (i as f64 + 0.5) * 2.0 * e.x / nx as f64,
+                            -e.y + (j as f64 + 0.5) * 2.0 * e.y / ny as f64,
+                        );
+                        if self.contains(p) {
+                            pts.push(p);
+                        }
+                    }
+                }
+                let w = area / pts.len().max(1) as f64;
+                pts.into_iter().map(|p| (p, w)).collect()
             }
             Outline::Disc { r } => {
                 let k = ((n as f64 * 4.0 / PI).sqrt().ceil() as usize).max(2);
@@ -271,22 +349,45 @@ pub enum Family {
         half: DVec3,
         rest: DQuat,
     },
+    /// A box on its largest face, rolled about its long axis by `alpha`, then pitched
+    /// about the horizontal axis across it by `pitch`: its top view is a hexagon, its
+    /// end face showing beside its top.
+    BoxTilted {
+        half: DVec3,
+        rest: DQuat,
+        pitch: f64,
+    },
     /// A box standing on its smallest face.
     BoxUpright {
         half: DVec3,
         rest: DQuat,
     },
-    /// A mesh as its file stands (`tip` None), or tipped over by 90 degrees after a yaw
-    /// of `tip` radians.
+    /// A mesh as its file stands (`tip` None), or tipped over by `lean` radians (up to
+    /// 90 degrees: lying) after a yaw of `tip` radians.
     Mesh {
         mesh: Arc<TriMesh>,
         tip: Option<f64>,
+        lean: f64,
         outline: Outline,
     },
 }
 
 /// Roll angles tried for a lying box (the search refines them).
 const ROLLS: [f64; 7] = [0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0];
+
+/// Pitches (degrees) of the tilted box families: a box thrown with a spin is seldom
+/// flat or on edge at `t`, and its shadow is then a hexagon.
+const PITCHES: [f64; 2] = [25.0, 50.0];
+
+/// Roll angles tried for a tilted box: fewer than for a lying one, since a pitched box
+/// barely rolled or rolled onto its edge shows a rectangle, as a lying one does (the
+/// search refines the roll from these).
+const TILTED_ROLLS: [f64; 3] = [22.5, 45.0, 67.5];
+
+/// Angles (degrees) a tall mesh is tipped over by: lying, and leaning part way, whose
+/// top view is the side foreshortened toward the base (a piece thrown with a spin is
+/// seldom exactly upright or lying at `t`).
+const LEANS: [f64; 4] = [90.0, 67.5, 45.0, 22.5];
 
 /// Every family of poses of `shape`.
 pub fn families(shape: &Shape) -> Vec<Family> {
@@ -307,29 +408,56 @@ pub fn families(shape: &Shape) -> Vec<Family> {
                 half: *half_extents,
                 rest: upright,
             });
+            out.extend(PITCHES.iter().map(|p| Family::BoxTilted {
+                half: *half_extents,
+                rest: lying,
+                pitch: p.to_radians(),
+            }));
             out
         }
         Shape::Mesh(mesh) => {
             let mut out = Vec::new();
-            let mut push = |tip: Option<f64>| {
+            let mut push = |tip: Option<f64>, lean: f64| {
                 let f = Family::Mesh {
                     mesh: mesh.clone(),
                     tip,
+                    lean,
                     outline: Outline::Disc { r: 0.0 },
                 };
                 let pose = f.pose(0.0);
                 out.push(Family::Mesh {
                     mesh: mesh.clone(),
                     tip,
+                    lean,
                     outline: pose.outline,
                 });
             };
-            push(None);
+            push(None, 0.0);
             let (lo, hi) = mesh.bounding_box();
             let e = hi - lo;
             if e.z >= 1.3 * e.x.max(e.y) {
-                push(Some(0.0));
-                push(Some(FRAC_PI_2));
+                // A body of revolution shows the same side from every yaw: one yaw does
+                // (the search turns outlines in the picture's plane), and half as many
+                // families halve the search. A knight needs both.
+                let side = |yaw: f64| {
+                    let f = Family::Mesh {
+                        mesh: mesh.clone(),
+                        tip: Some(yaw),
+                        lean: FRAC_PI_2,
+                        outline: Outline::Disc { r: 0.0 },
+                    };
+                    f.pose(0.0).outline
+                };
+                let yaws: &[f64] = if side(0.0).matches(&side(FRAC_PI_2)) {
+                    &[0.0]
+                } else {
+                    &[0.0, FRAC_PI_2]
+                };
+                for lean in LEANS {
+                    for &yaw in yaws {
+                        push(Some(yaw), lean.to_radians());
+                    }
+                }
             }
             out
         }
@@ -349,13 +477,14 @@ impl Family {
     pub fn alphas(&self) -> Vec<f64> {
         match self {
             Family::BoxLying { .. } => ROLLS.iter().map(|d| d.to_radians()).collect(),
+            Family::BoxTilted { .. } => TILTED_ROLLS.iter().map(|d| d.to_radians()).collect(),
             _ => vec![0.0],
         }
     }
 
     /// Whether the roll angle is a continuous parameter.
     pub fn rolls(&self) -> bool {
-        matches!(self, Family::BoxLying { .. })
+        matches!(self, Family::BoxLying { .. } | Family::BoxTilted { .. })
     }
 
     /// The pose of this family at roll `alpha` (ignored by the families that do not roll).
@@ -387,6 +516,24 @@ impl Family {
                     lift: 0.5 * c,
                 }
             }
+            Family::BoxTilted { half, rest, pitch } => {
+                let a = alpha.clamp(0.0, FRAC_PI_2);
+                let turn = DQuat::from_rotation_y(*pitch) * DQuat::from_rotation_x(a);
+                let (axis, angle) = turn.to_axis_angle();
+                let q = turn * *rest;
+                let corners: Vec<DVec3> = box_corners(*half).iter().map(|c| q * *c).collect();
+                let top: Vec<DVec2> = corners.iter().map(|c| c.truncate()).collect();
+                let half_height = corners.iter().map(|c| c.z).fold(0.0, f64::max);
+                Pose {
+                    rest: *rest,
+                    turn_axis: if angle == 0.0 { DVec3::ZERO } else { axis },
+                    turn: angle,
+                    centre: DVec3::ZERO,
+                    half_height,
+                    outline: Outline::Polygon(Arc::new(convex_hull(&top))),
+                    lift: (*rest * *half).abs().z,
+                }
+            }
             Family::BoxUpright { half, rest } => {
                 // `rest` lays the middle axis along x and the short one along y, so the
                 // long axis stands along z.
@@ -404,10 +551,15 @@ impl Family {
                     lift: e.z,
                 }
             }
-            Family::Mesh { mesh, tip, outline } => {
+            Family::Mesh {
+                mesh,
+                tip,
+                lean,
+                outline,
+            } => {
                 let rest = DQuat::from_rotation_z(tip.unwrap_or(0.0));
                 let (turn_axis, turn) = match tip {
-                    Some(_) => (DVec3::Y, FRAC_PI_2),
+                    Some(_) => (DVec3::Y, *lean),
                     None => (DVec3::ZERO, 0.0),
                 };
                 let mut pose = Pose {
@@ -520,7 +672,8 @@ mod tests {
         ];
         let shape = Shape::Mesh(Arc::new(TriMesh::new(v, t)));
         let fams = families(&shape);
-        assert_eq!(fams.len(), 3);
+        // Standing, and tipped by each lean at one yaw: its side is the same from both.
+        assert_eq!(fams.len(), 1 + LEANS.len());
         let up = fams[0].pose(0.0);
         assert!((up.half_height - 0.05).abs() < 1e-9 && up.lift.abs() < 1e-12);
         let tipped = fams[1].pose(0.0);
@@ -535,6 +688,120 @@ mod tests {
         assert!((tipped.outline.area() - 0.002).abs() < 2e-4);
         let total: f64 = tipped.outline.samples(200).iter().map(|s| s.1).sum();
         assert!((total - tipped.outline.area()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_leaning_piece_shows_its_side_foreshortened() {
+        // A king-like solid of revolution 6 cm tall on a base 2.5 cm across.
+        let profile = [
+            (0.0, 0.0),
+            (0.0125, 0.0),
+            (0.0125, 0.004),
+            (0.006, 0.012),
+            (0.005, 0.045),
+            (0.009, 0.05),
+            (0.006, 0.058),
+            (0.0, 0.060),
+        ];
+        let king = Arc::new(crate::geometry::shape::tests::lathe(&profile, 48));
+        let fams = families(&Shape::Mesh(king.clone()));
+        assert_eq!(
+            fams.len(),
+            1 + LEANS.len(),
+            "a body of revolution needs one yaw"
+        );
+        let side = |lean: f64| {
+            fams.iter()
+                .find(|f| matches!(f, Family::Mesh { tip: Some(_), lean: l, .. } if (l - lean.to_radians()).abs() < 1e-12))
+                .expect("a family per lean")
+                .pose(0.0)
+        };
+        // Lying, its length along x is the piece's height (6 cm). Leaning 45 degrees,
+        // its top view spans the posed vertices' (the height foreshortened by sin 45,
+        // the base's far side by cos 45), to the outline grid's cells (96 along it).
+        let lying = side(90.0).outline.half_extents();
+        assert!((2.0 * lying.x - 0.060).abs() < 0.0015, "{lying}");
+        let leaning = side(45.0);
+        let e = leaning.outline.half_extents();
+        let q = leaning.rotation();
+        let xs: Vec<f64> = king.vertices.iter().map(|v| (q * *v).x).collect();
+        let span = xs.iter().cloned().fold(f64::MIN, f64::max)
+            - xs.iter().cloned().fold(f64::MAX, f64::min);
+        // The head's rim (radius 6 mm at 5.8 cm) reaches farthest; the foot's edge
+        // on the other side.
+        let head = 0.058 * FRAC_PI_4.sin() + 0.006 * FRAC_PI_4.cos();
+        let foot = 0.0125 * FRAC_PI_4.cos();
+        assert!((span - (head + foot)).abs() < 1e-9, "{span}");
+        assert!(
+            (2.0 * e.x - span).abs() < 4.0 * span / 96.0,
+            "{e} vs {span}"
+        );
+        assert!(2.0 * e.x < 2.0 * lying.x - 0.005);
+        // The pose turns the piece by its lean about a horizontal axis.
+        let up = leaning.rotation() * DVec3::Z;
+        assert!((up.z - FRAC_PI_4.cos()).abs() < 1e-12, "{up}");
+        // A piece that is not round (a flat slab standing on edge) keeps both yaws.
+        let slab = Shape::Cuboid {
+            half_extents: DVec3::new(0.02, 0.005, 0.05),
+        };
+        let Shape::Cuboid { half_extents } = slab else {
+            unreachable!()
+        };
+        let corners = box_corners(half_extents);
+        let v: Vec<DVec3> = corners.iter().map(|c| *c + DVec3::Z * 0.05).collect();
+        let faces: Vec<[u32; 3]> = vec![
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ];
+        let fams = families(&Shape::Mesh(Arc::new(TriMesh::new(v, faces))));
+        assert_eq!(fams.len(), 1 + 2 * LEANS.len());
+    }
+
+    #[test]
+    fn a_tilted_box_shows_a_hexagon() {
+        let half = DVec3::new(0.07, 0.035, 0.0175);
+        let fams = families(&Shape::Cuboid { half_extents: half });
+        let tilted: Vec<&Family> = fams
+            .iter()
+            .filter(|f| matches!(f, Family::BoxTilted { .. }))
+            .collect();
+        assert_eq!(tilted.len(), PITCHES.len());
+        for f in tilted {
+            for deg in [0.0f64, 30.0, 60.0] {
+                let pose = f.pose(deg.to_radians());
+                let Outline::Polygon(hull) = &pose.outline else {
+                    panic!("a tilted box's top view is a polygon");
+                };
+                // Rolled, a pitched box shows three faces: a hexagon.
+                assert_eq!(hull.len(), if deg == 0.0 { 4 } else { 6 }, "{deg}");
+                // The outline is the posed corners' top view: each corner is inside (or
+                // on) it, and a point just beyond the farthest corner is not.
+                let q = pose.rotation();
+                let corners: Vec<DVec3> = box_corners(half).iter().map(|c| q * *c).collect();
+                for c in &corners {
+                    assert!(pose.outline.contains(c.truncate() * (1.0 - 1e-9)));
+                }
+                let far = corners.iter().max_by(|a, b| a.x.total_cmp(&b.x)).unwrap();
+                assert!(!pose.outline.contains(far.truncate() + DVec2::X * 1e-6));
+                let top = corners.iter().map(|c| c.z).fold(f64::MIN, f64::max);
+                assert!((top - pose.half_height).abs() < 1e-12);
+                // Its samples cover its area.
+                let s = pose.outline.samples(150);
+                let total: f64 = s.iter().map(|p| p.1).sum();
+                assert!((total - pose.outline.area()).abs() < 1e-12);
+                assert!(s.len() >= 100 && s.len() <= 220, "{}", s.len());
+            }
+        }
     }
 
     #[test]
