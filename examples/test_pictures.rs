@@ -4,7 +4,7 @@
 //! (DejaVu Sans's airplane, chess knight and umbrella symbols), 640 x 480, black on
 //! white, each with the box of objects it is to be made of, stated before any solve.
 //!
-//! Eight sets: set 1 (`tools/test-pictures`), the pictures `bsa new` was developed on;
+//! Nine sets: set 1 (`tools/test-pictures`), the pictures `bsa new` was developed on;
 //! set 2 (`tools/test-pictures-2`), drawn after the code was final and solved once, for
 //! the figures of the issue: letters, digits, outlines, a filled star, a snowman of
 //! discs and two DejaVu symbols (heart and spade) as silhouettes; set 3
@@ -23,9 +23,13 @@
 //! a row, and the scissors and sun symbols); set 8 (`tools/test-pictures-8`), drawn
 //! after a later session's last design change (lowercase b, d, g, m, p, s, l, the
 //! less-than and ampersand signs, a window of bars, a caterpillar of discs, and the
-//! flag and eighth-note symbols), with generous boxes of objects.
+//! flag and eighth-note symbols), with generous boxes of objects; set 9
+//! (`tools/test-pictures-9`), drawn after a later session's last design change (the
+//! letter E, lowercase c, i, j, q, the greater-than, dollar, asterisk and slash signs,
+//! the check mark and lightning symbols, a pyramid of six discs, and the shamrock
+//! symbol), its boxes stated as for set 8.
 //!
-//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 8,
+//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 9,
 //! default 1; DIR default `tools/test-pictures[-SET]`): writes
 //! `DIR/<name>.png` and `DIR/manifest.tsv` (name, objects, extra `bsa new` options),
 //! which `scripts/new-suite.sh` reads. The output depends only on the font file and
@@ -239,6 +243,46 @@ fn caterpillar(x: f64, y: f64) -> bool {
         let (cx, cy) = (-190.0 * a.cos(), 110.0 * a.sin() - 50.0);
         (x - cx).hypot(y - cy) <= 34.0
     })
+}
+
+fn pyramid(x: f64, y: f64) -> bool {
+    // Six discs of radius 36 stacked three, two, one, apart.
+    let rows = [(3, -90.0), (2, 0.0), (1, 90.0)];
+    rows.iter().any(|&(n, cy)| {
+        (0..n).any(|k| {
+            let cx = (k as f64 - (n - 1) as f64 / 2.0) * 100.0;
+            (x - cx).hypot(y - cy) <= 36.0
+        })
+    })
+}
+
+/// Set 9: defined in a later session after its last change to the design (leaning
+/// chess pieces, pitched boxes), its objects stated with it as an artist would fill each
+/// picture, and run once.
+fn pictures_9() -> Vec<(&'static str, Shape, String, &'static str)> {
+    let chess_stage = "--width 0.96 --light-height 3";
+    let glyph = |name, c, objects: String| (name, Shape::Glyph(c, 6), objects, "");
+    let chess = |name, c| (name, Shape::Glyph(c, 0), "chess".to_string(), chess_stage);
+    vec![
+        glyph("letter-e", 'E', format!("{DOUBLE},{UNIT}*3")),
+        glyph("small-c", 'c', format!("{UNIT}*5")),
+        glyph("small-i", 'i', format!("{UNIT},{HALF}")),
+        glyph("small-j", 'j', format!("{DOUBLE},{UNIT},{HALF}")),
+        glyph("small-q", 'q', format!("{DOUBLE},{UNIT}*5")),
+        glyph("greater-than", '>', format!("{DOUBLE}*2")),
+        glyph("dollar", '$', format!("{DOUBLE},{UNIT}*7")),
+        glyph("asterisk", '*', format!("{UNIT}*3")),
+        glyph("slash", '/', DOUBLE.to_string()),
+        glyph("check", '\u{2713}', format!("{DOUBLE},{UNIT}")),
+        glyph("lightning", '\u{26A1}', format!("{DOUBLE}*2,{UNIT}*2")),
+        (
+            "pyramid",
+            Shape::Drawn(pyramid),
+            "sphere:0.07*6".to_string(),
+            "",
+        ),
+        chess("shamrock", '\u{2618}'),
+    ]
 }
 
 /// Set 8: defined in a later session after its last change to the design (the
@@ -737,7 +781,8 @@ fn main() -> Result<(), Box<dyn Error>> {
         "6" => (pictures_6(), "tools/test-pictures-6"),
         "7" => (pictures_7(), "tools/test-pictures-7"),
         "8" => (pictures_8(), "tools/test-pictures-8"),
-        other => return Err(format!("SET must be 1 to 8, got {other:?}").into()),
+        "9" => (pictures_9(), "tools/test-pictures-9"),
+        other => return Err(format!("SET must be 1 to 9, got {other:?}").into()),
     };
     let dir = args
         .get(1)
