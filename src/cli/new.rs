@@ -368,7 +368,13 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             }
         }
     }
-    let Some(Variant { plan, moves, .. }) = best else {
+    let Some(Variant {
+        plan,
+        moves,
+        solved,
+        ..
+    }) = best
+    else {
         return Err(first_error.expect("every ceiling gave a design or an error"));
     };
     // The folder's scene is replaced only now, target first: a scene.json is never left
@@ -393,10 +399,11 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         &Weights::default(),
         &mut ws,
     );
+    let start_picture = problem.picture_of(&ws.mask);
     files::save_overlay(
         &dir.join("start.png"),
         &problem.scene.target,
-        &problem.picture_of(&ws.mask),
+        &start_picture,
         &format!("{name}: the start guess at t, before any solve"),
     )?;
     let n = plan.objects.len();
@@ -420,7 +427,40 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         dir.display(),
         dir.display()
     );
+    let target = &problem.scene.target;
+    let missed = target.and_not_count(&start_picture) as f64 / target.count().max(1) as f64;
+    if let Some(note) = too_few_objects(
+        missed,
+        solved.map_or(start.iou, |s| s.iou),
+        opts.inventory.auto.is_some(),
+    ) {
+        eprintln!("{name}: note: {note}");
+    }
     Ok(())
+}
+
+/// Share of the target the start guess leaves bare (0 to 1) from which, with a final
+/// (or start) IoU below [`SHORT_IOU`], the objects are taken to be too few or of the
+/// wrong proportions for the picture.
+const BARE_SHARE: f64 = 0.15;
+const SHORT_IOU: f64 = 0.9;
+
+/// A note for the user when the box of objects cannot draw the picture: most of what
+/// the start guess misses is target no object's shadow reaches, which no solve can
+/// fill. `None` when the objects suffice.
+fn too_few_objects(missed: f64, iou: f64, auto: bool) -> Option<String> {
+    if missed <= BARE_SHARE || iou >= SHORT_IOU {
+        return None;
+    }
+    let advice = if auto {
+        "objects shaped more like its parts"
+    } else {
+        "more objects, or objects shaped more like its parts (auto:box:XxYxZ, auto:sphere or auto:chess lets bsa new choose how many)"
+    };
+    Some(format!(
+        "the objects leave {:.0} % of the picture bare at the start, and the design reaches IoU {iou:.3}; the picture may need {advice}",
+        100.0 * missed
+    ))
 }
 
 /// Where a design's trial solve ended.

@@ -188,6 +188,8 @@ fn new_designs_a_scene_that_solve_takes_as_it_is() {
         "4",
     ]);
     assert!(ok && out.contains("start guess IoU"), "{err}");
+    // Three spheres for Mickey's three discs: nothing to note.
+    assert!(!err.contains("note:"), "{err}");
     // Exactly the three files: the designs tried under the other ceilings are gone.
     let mut files: Vec<String> = std::fs::read_dir(&dir)
         .unwrap()
@@ -197,6 +199,31 @@ fn new_designs_a_scene_that_solve_takes_as_it_is() {
     assert_eq!(files, ["scene.json", "start.png", "target.png"]);
     let (ok, _, err) = bsa(&["check", dir.to_str().unwrap()]);
     assert!(ok, "{err}");
+}
+
+#[test]
+fn new_tells_when_the_objects_cannot_cover_the_picture() {
+    // One small sphere for Mickey's head and two ears: most of the picture stays bare
+    // whatever the solve does, and the user is told what to bring.
+    let d = tmpdir("new-few");
+    let dir = d.join("mickey");
+    let target = root().join("scenes/mickey/target.png");
+    let (ok, _, err) = bsa(&[
+        "new",
+        dir.to_str().unwrap(),
+        "--target",
+        target.to_str().unwrap(),
+        "--objects",
+        "sphere:0.35",
+        "--width",
+        "4",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("note: the objects leave") && err.contains("% of the picture bare"),
+        "{err}"
+    );
+    assert!(err.contains("auto:"), "{err}");
 }
 
 #[test]
