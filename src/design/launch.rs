@@ -200,12 +200,12 @@ impl Plan {
         let q0 = yaw * o.pose.rest;
         let slot = self.slots[o.slot];
         let origin0 = DVec3::new(slot.x, slot.y, g.table_top + o.pose.lift + 1e-6);
-        let com = o.object.shape.mass_properties(o.object.density).local_com;
+        let mass = o.object.shape.mass_properties(o.object.density);
+        let com = mass.local_com;
         let (com0, com_t) = (origin0 + q0 * com, origin_t + q_t * com);
         let t = g.t;
         let velocity = (com_t - com0 - 0.5 * g.gravity * t * t) / t;
         let turn = if o.flip { -o.pose.turn } else { o.pose.turn };
-        let mass = o.object.shape.mass_properties(o.object.density);
         let angular_velocity = spin_to(&mass, q0, q_t, yaw * o.pose.turn_axis * (turn / t), t);
         Start {
             position: origin0,

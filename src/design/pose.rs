@@ -2,17 +2,19 @@
 //! vocabulary of poses ([`Family`], [`Pose`]) and their top views ([`Outline`]).
 //!
 //! Every pose starts from a rest pose on the table (how the object lies at launch) and
-//! reaches its pose at `t` by one turn about a horizontal principal axis at a constant
-//! rate, so the launch spin that produces it is exact for boxes and bodies of
-//! revolution:
+//! reaches its pose at `t` by one turn at a constant rate. About a principal axis of
+//! the body (every family but the pitched box, and the knight's) the spin that produces
+//! it is exact; otherwise `design::launch` corrects the spin on the real flight:
 //! - a box lies on its largest face with its long axis along the stroke and rolls about
 //!   that axis by `alpha` (0 to 90 degrees): its top view is a rectangle of its length by
 //!   `B cos(alpha) + C sin(alpha)`, so the roll sets the shadow's width; or it stands on
-//!   its end (top view its B x C end) and does not turn;
+//!   its end (top view its B x C end) and does not turn; or, rolled, it is also pitched
+//!   across the stroke, and its top view is a hexagon ([`Outline::Polygon`]);
 //! - a sphere shows a disc;
 //! - a mesh stands as its file has it (top view from above), or, when it is tall (a
-//!   chess piece), tips over by 90 degrees about a horizontal axis to lie along the
-//!   stroke (top view its side, seen from two directions 90 degrees apart).
+//!   chess piece), tips over about a horizontal axis to lie along the stroke or lean
+//!   part way (top view its side, foreshortened when leaning, seen from two directions
+//!   90 degrees apart unless both look the same).
 //!
 //! Objects are small beside their distance to the light, so a shadow is taken as the
 //! top view magnified by `m = H / (H - z)` about the point under the light, `z` being
@@ -301,8 +303,8 @@ impl Outline {
 pub struct Pose {
     /// Body frame -> table frame at launch, before the yaw that turns it to its stroke.
     pub rest: DQuat,
-    /// The turn from the rest pose to the pose at `t`: a horizontal unit axis in the
-    /// (unyawed) table frame, or zero, and the angle (rad).
+    /// The turn from the rest pose to the pose at `t`: a unit axis in the (unyawed)
+    /// table frame (horizontal but for a pitched box), or zero, and the angle (rad).
     pub turn_axis: DVec3,
     pub turn: f64,
     /// Centre of the posed body's bounding box relative to its origin, in the unyawed
@@ -384,10 +386,10 @@ const PITCHES: [f64; 2] = [25.0, 50.0];
 /// search refines the roll from these).
 const TILTED_ROLLS: [f64; 3] = [22.5, 45.0, 67.5];
 
-/// Angles (degrees) a tall mesh is tipped over by: lying, and leaning part way, whose
-/// top view is the side foreshortened toward the base (a piece thrown with a spin is
-/// seldom exactly upright or lying at `t`).
-const LEANS: [f64; 4] = [90.0, 67.5, 45.0, 22.5];
+/// Angles (degrees) a tall mesh leans by besides lying (90): part way, its top view is
+/// its side foreshortened toward the base (a piece thrown with a spin is seldom exactly
+/// upright or lying at `t`).
+const LEANS: [f64; 3] = [67.5, 45.0, 22.5];
 
 /// Every family of poses of `shape`.
 pub fn families(shape: &Shape) -> Vec<Family> {
@@ -416,46 +418,28 @@ pub fn families(shape: &Shape) -> Vec<Family> {
             out
         }
         Shape::Mesh(mesh) => {
-            let mut out = Vec::new();
-            let mut push = |tip: Option<f64>, lean: f64| {
-                let f = Family::Mesh {
-                    mesh: mesh.clone(),
-                    tip,
-                    lean,
-                    outline: Outline::Disc { r: 0.0 },
-                };
-                let pose = f.pose(0.0);
-                out.push(Family::Mesh {
-                    mesh: mesh.clone(),
-                    tip,
-                    lean,
-                    outline: pose.outline,
-                });
-            };
-            push(None, 0.0);
+            let mut out = vec![Family::of_mesh(mesh, None, 0.0)];
             let (lo, hi) = mesh.bounding_box();
             let e = hi - lo;
             if e.z >= 1.3 * e.x.max(e.y) {
-                // A body of revolution shows the same side from every yaw: one yaw does
-                // (the search turns outlines in the picture's plane), and half as many
-                // families halve the search. A knight needs both.
-                let side = |yaw: f64| {
-                    let f = Family::Mesh {
-                        mesh: mesh.clone(),
-                        tip: Some(yaw),
-                        lean: FRAC_PI_2,
-                        outline: Outline::Disc { r: 0.0 },
-                    };
-                    f.pose(0.0).outline
+                // Lying, seen from two yaws 90 degrees apart; a body of revolution shows
+                // the same side from every yaw, so one does (the search turns outlines
+                // in the picture's plane), and half as many families halve the search.
+                // A knight needs both.
+                let lying = [0.0, FRAC_PI_2].map(|yaw| Family::of_mesh(mesh, Some(yaw), FRAC_PI_2));
+                let [Family::Mesh { outline: a, .. }, Family::Mesh { outline: b, .. }] = &lying
+                else {
+                    unreachable!("of_mesh makes mesh families")
                 };
-                let yaws: &[f64] = if side(0.0).matches(&side(FRAC_PI_2)) {
+                let yaws: &[f64] = if a.matches(b) {
                     &[0.0]
                 } else {
                     &[0.0, FRAC_PI_2]
                 };
+                out.extend(lying.into_iter().take(yaws.len()));
                 for lean in LEANS {
                     for &yaw in yaws {
-                        push(Some(yaw), lean.to_radians());
+                        out.push(Family::of_mesh(mesh, Some(yaw), lean.to_radians()));
                     }
                 }
             }
@@ -473,6 +457,22 @@ fn frame_to(a: DVec3, b: DVec3) -> DQuat {
 }
 
 impl Family {
+    /// The mesh family of `tip` and `lean` (see [`Family::Mesh`]) with its top view.
+    fn of_mesh(mesh: &Arc<TriMesh>, tip: Option<f64>, lean: f64) -> Family {
+        let placeholder = Family::Mesh {
+            mesh: mesh.clone(),
+            tip,
+            lean,
+            outline: Outline::Disc { r: 0.0 },
+        };
+        Family::Mesh {
+            mesh: mesh.clone(),
+            tip,
+            lean,
+            outline: placeholder.pose(0.0).outline,
+        }
+    }
+
     /// Roll angles (rad) to try; one value for the families that have no roll.
     pub fn alphas(&self) -> Vec<f64> {
         match self {
@@ -673,7 +673,7 @@ mod tests {
         let shape = Shape::Mesh(Arc::new(TriMesh::new(v, t)));
         let fams = families(&shape);
         // Standing, and tipped by each lean at one yaw: its side is the same from both.
-        assert_eq!(fams.len(), 1 + LEANS.len());
+        assert_eq!(fams.len(), 2 + LEANS.len());
         let up = fams[0].pose(0.0);
         assert!((up.half_height - 0.05).abs() < 1e-9 && up.lift.abs() < 1e-12);
         let tipped = fams[1].pose(0.0);
@@ -707,7 +707,7 @@ mod tests {
         let fams = families(&Shape::Mesh(king.clone()));
         assert_eq!(
             fams.len(),
-            1 + LEANS.len(),
+            2 + LEANS.len(),
             "a body of revolution needs one yaw"
         );
         let side = |lean: f64| {
@@ -764,7 +764,7 @@ mod tests {
             [3, 7, 5],
         ];
         let fams = families(&Shape::Mesh(Arc::new(TriMesh::new(v, faces))));
-        assert_eq!(fams.len(), 1 + 2 * LEANS.len());
+        assert_eq!(fams.len(), 1 + 2 * (1 + LEANS.len()));
     }
 
     #[test]
