@@ -293,8 +293,8 @@ fn sequential_rounds_repeat_the_pass_and_are_checked() {
 
 #[test]
 fn example_scenes_start_without_contact_near_their_targets() {
-    // The generator (tools/make_scenes.py) promises start guesses that fly without
-    // contact; the solver's sequential stages rely on it (a held pair that collides hides
+    // `bsa new`, which designed these scenes (scripts/make-examples.sh), promises start
+    // guesses that fly without contact; the solver's sequential stages rely on it (a held pair that collides hides
     // every later contact from the stage's penalty).
     for name in ["fly", "tbc", "thinker"] {
         let p = Problem::new(bsa::scene::load(&root().join("scenes").join(name)).unwrap());
