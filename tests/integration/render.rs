@@ -444,6 +444,14 @@ fn new_keeps_the_design_that_solves_best_and_solve_ends_where_its_trial_did() {
     let best = ious.iter().copied().fold(0.0, f64::max);
     let at = ceilings.iter().position(|&c| c == kept).unwrap();
     assert_eq!(ious[at], best, "{out}");
+    // The example in scenes/fly is this design, byte for byte: the examples come from
+    // `bsa new`, and a change of the design shows here until they are made again.
+    let designed = std::fs::read_to_string(dir.join("scene.json")).unwrap();
+    let committed = std::fs::read_to_string(root().join("scenes/fly/scene.json")).unwrap();
+    assert!(
+        designed == committed,
+        "scenes/fly/scene.json is not what `bsa new` designs today: run bash scripts/make-examples.sh"
+    );
     // The written scene is the design that was tried: its solve ends where the trial did.
     let solved = d.join("out");
     solve(&dir, &solved, &[]);
