@@ -6,10 +6,10 @@
 //! target. Everything the user reads (the start IoU, a contact) comes from the scene
 //! file as written, loaded afresh.
 //!
-//! The design is made under each of [`design::CEILINGS`]; by default ([`ChooseBy::Solve`])
-//! each is then solved as `bsa solve` will solve it (the scene's seed, the scene's
-//! strategy) and the one whose solve ends at the best picture, contact-free first, is
-//! written. A start guess's IoU says little of where its solve ends: on 27 held-out
+//! The design is made under each of [`design::CEILINGS`] in each of [`design::ORDERS`];
+//! by default ([`ChooseBy::Solve`]) each design that differs from those before it is
+//! then solved as `bsa solve` will solve it (the scene's seed, the scene's strategy)
+//! and the one whose solve ends at the best picture, contact-free first, is written. A start guess's IoU says little of where its solve ends: on 27 held-out
 //! pictures the design with the best start was the best solved one for 12.
 //!
 //! Until the scene is written, `bsa new` works in scratch files in the folder (a copy of
@@ -29,7 +29,7 @@ use crate::design::inventory::{AutoKind, Inventory, Kind};
 use crate::design::launch::{Geometry, Object, Plan};
 use crate::design::picture::Picture;
 use crate::design::plant::{default_strategy, Stage};
-use crate::design::{self, chess, separate, AutoRequest, Request};
+use crate::design::{self, chess, separate, AutoRequest, Order, Request};
 use crate::energy::Weights;
 use crate::evaluate::Problem;
 use crate::optimize::solver::{self, Silent, SolveOptions};
@@ -60,7 +60,7 @@ pub(super) struct Options {
     choose_by: ChooseBy,
 }
 
-/// How `bsa new` chooses among its designs (one per ceiling).
+/// How `bsa new` chooses among its designs (one per ceiling and order).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub(super) enum ChooseBy {
     /// The design whose solve (as `bsa solve` runs it) ends at the best picture.
@@ -244,7 +244,12 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let dir = &opts.dir;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let probe_file = dir.join(SCRATCH_PROBE);
-    let design_files: Vec<PathBuf> = (0..design::CEILINGS.len())
+    // Every (order, ceiling) the design is made under, orders outermost.
+    let settings: Vec<(Order, f64)> = design::ORDERS
+        .iter()
+        .flat_map(|&o| design::CEILINGS.iter().map(move |&c| (o, c)))
+        .collect();
+    let design_files: Vec<PathBuf> = (0..settings.len())
         .map(|k| dir.join(format!(".bsa-new-design-{k}.json")))
         .collect();
     let scratch = Scratch::new(
@@ -311,40 +316,79 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         t: scene.t,
         ceiling: design::CEILINGS[0],
     };
-    // One design per ceiling, in parallel, each written to its own file beside the
-    // scene (mesh paths are relative to the folder), made contact-free and, by default,
-    // solved; the best (see `Variant::better_than`) is kept.
+    // One design per order and ceiling, in parallel, each written to its own file
+    // beside the scene (mesh paths are relative to the folder) and made contact-free;
+    // then, by default, each design that differs from the others is solved. The best
+    // (see `Variant::better_than`) is kept.
     let trial = opts.choose_by == ChooseBy::Solve;
     let bar = progress::steps(
-        design::CEILINGS.len() as u64,
+        settings.len() as u64,
         &format!(
-            "{name}: designing{} under {} ceilings",
-            if trial { " and solving" } else { "" },
-            design::CEILINGS.len()
+            "{name}: designing under {} ceilings and {} orders",
+            design::CEILINGS.len(),
+            design::ORDERS.len()
         ),
     );
-    let variants: Vec<Result<Variant>> = design::CEILINGS
+    let designed: Vec<Result<Variant>> = settings
         .par_iter()
         .enumerate()
-        .map(|(k, &ceiling)| {
-            let file = &design_files[k];
+        .map(|(k, &(order, ceiling))| {
+            let geometry = Geometry {
+                ceiling,
+                ..geometry.clone()
+            };
             let variant = design_variant(
                 &picture,
-                Geometry {
-                    ceiling,
-                    ..geometry.clone()
-                },
+                geometry,
                 &request,
-                file,
+                order,
+                &design_files[k],
                 &name,
                 opts.seed,
-                trial,
             );
             bar.inc(1);
             variant
         })
         .collect();
     bar.finish_and_clear();
+    // A design that another order made too (one kind of object, or the same choices)
+    // is solved once.
+    let scenes: Vec<Option<String>> = designed
+        .iter()
+        .map(|v| {
+            v.as_ref().ok().map(|v| {
+                v.plan
+                    .scene_json(&name, SCRATCH_TARGET, opts.seed)
+                    .to_string()
+            })
+        })
+        .collect();
+    let same_as: Vec<Option<usize>> = (0..designed.len())
+        .map(|k| (0..k).find(|&j| scenes[k].is_some() && scenes[j] == scenes[k]))
+        .collect();
+    let mut designed = designed;
+    if trial {
+        let todo: Vec<usize> = (0..designed.len())
+            .filter(|&k| designed[k].is_ok() && same_as[k].is_none())
+            .collect();
+        let bar = progress::steps(todo.len() as u64, &format!("{name}: solving the designs"));
+        let solved: Vec<(usize, Result<Solved>)> = todo
+            .par_iter()
+            .map(|&k| {
+                let v = designed[k].as_ref().expect("a design to solve");
+                let s = trial_solve(&v.plan, &design_files[k], &name, opts.seed);
+                bar.inc(1);
+                (k, s)
+            })
+            .collect();
+        bar.finish_and_clear();
+        for (k, s) in solved {
+            match s {
+                Ok(s) => designed[k].as_mut().expect("a solved design").solved = Some(s),
+                Err(e) => designed[k] = Err(e),
+            }
+        }
+    }
     if INTERRUPTS.load(Ordering::SeqCst) > 0 {
         return Err(NothingWritten {
             dir: dir.display().to_string(),
@@ -353,17 +397,21 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     }
     let mut best: Option<Variant> = None;
     let mut first_error = None;
-    // Each design's ceiling and trial solve, for the line that reports them.
-    let mut variants_seen: Vec<(f64, Option<Solved>)> = Vec::new();
-    for v in variants {
+    // Each design's trial, for the line that reports them.
+    let mut seen: Vec<Trial> = Vec::new();
+    for (k, v) in designed.into_iter().enumerate() {
         match v {
             Ok(v) => {
-                variants_seen.push((v.plan.geometry.ceiling, v.solved));
+                seen.push(match same_as[k] {
+                    Some(_) => Trial::Same,
+                    None => Trial::Solved(v.solved),
+                });
                 if best.as_ref().is_none_or(|b| v.better_than(b)) {
                     best = Some(v);
                 }
             }
             Err(e) => {
+                seen.push(Trial::Failed);
                 first_error.get_or_insert(e);
             }
         }
@@ -372,10 +420,11 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         plan,
         moves,
         solved,
+        order,
         ..
     }) = best
     else {
-        return Err(first_error.expect("every ceiling gave a design or an error"));
+        return Err(first_error.expect("every setting gave a design or an error"));
     };
     // The folder's scene is replaced only now, target first: a scene.json is never left
     // beside a target it was not made for.
@@ -388,7 +437,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     if trial {
         println!(
             "{name}: {}",
-            trials_line(&variants_seen, plan.geometry.ceiling)
+            trials_line(&seen, (order, plan.geometry.ceiling))
         );
     }
     // What the user gets: the scene as written, loaded afresh.
@@ -472,9 +521,10 @@ struct Solved {
     clear: bool,
 }
 
-/// One design of the picture under one ceiling, made contact-free.
+/// One design of the picture under one ceiling and order, made contact-free.
 struct Variant {
     plan: Plan,
+    order: Order,
     /// Moves [`separate`] took.
     moves: usize,
     /// The start guess's IoU and whether it flies without contact before `t`.
@@ -501,24 +551,46 @@ fn rank(solved: Option<Solved>, clear: bool, iou: f64) -> (bool, f64, bool, f64)
     }
 }
 
-/// "trial solves under ceilings 0.8 / 0.7 / ... of the light's height: IoU a / b / ...;
-/// kept the design under c": what the choice was made on (a trial that ended with a
-/// contact says so).
-fn trials_line(seen: &[(f64, Option<Solved>)], kept: f64) -> String {
-    let ceilings: Vec<String> = seen.iter().map(|(c, _)| format!("{c}")).collect();
-    let ious: Vec<String> = seen
+/// What became of one design's trial solve, for [`trials_line`].
+#[derive(Clone, Copy, Debug)]
+enum Trial {
+    /// Solved (`None` when the choice is by the start guess).
+    Solved(Option<Solved>),
+    /// The same scene as a design before it, not solved again.
+    Same,
+    /// The design failed (its error is reported if no design succeeds).
+    Failed,
+}
+
+/// "trial solves under ceilings 0.8 / 0.7 / ... of the light's height: IoU a / b / ...
+/// (largest object first), e / same / ... (best fit first); kept the design under c,
+/// best fit first": what the choice was made on (a trial that ended with a contact
+/// says so; "same" is a design that an earlier order made too). `seen` is in the order
+/// of [`design::ORDERS`] then [`design::CEILINGS`].
+fn trials_line(seen: &[Trial], kept: (Order, f64)) -> String {
+    let ceilings: Vec<String> = design::CEILINGS.iter().map(|c| format!("{c}")).collect();
+    let per_order: Vec<String> = design::ORDERS
         .iter()
-        .map(|(_, s)| match s {
-            Some(s) if s.clear => format!("{:.4}", s.iou),
-            Some(s) => format!("{:.4} (contact)", s.iou),
-            None => "-".to_string(),
+        .zip(seen.chunks(design::CEILINGS.len()))
+        .map(|(order, trials)| {
+            let ious: Vec<String> = trials
+                .iter()
+                .map(|s| match s {
+                    Trial::Solved(Some(s)) if s.clear => format!("{:.4}", s.iou),
+                    Trial::Solved(Some(s)) => format!("{:.4} (contact)", s.iou),
+                    Trial::Solved(None) | Trial::Failed => "-".to_string(),
+                    Trial::Same => "same".to_string(),
+                })
+                .collect();
+            format!("{} ({})", ious.join(" / "), order.label())
         })
         .collect();
     format!(
-        "trial solves under ceilings {} of the light's height: IoU {}; kept the design under {}",
+        "trial solves under ceilings {} of the light's height: IoU {}; kept the design under {}, {}",
         ceilings.join(" / "),
-        ious.join(" / "),
-        kept
+        per_order.join(", "),
+        kept.1,
+        kept.0.label()
     )
 }
 
@@ -528,12 +600,12 @@ fn design_variant(
     picture: &Picture,
     geometry: Geometry,
     request: &Request,
+    order: Order,
     file: &Path,
     name: &str,
     seed: u64,
-    trial: bool,
 ) -> Result<Variant> {
-    let mut plan = design::design(picture, geometry, request)?;
+    let mut plan = design::design(picture, geometry, request, order)?;
     let json = plan.scene_json(name, SCRATCH_TARGET, seed);
     files::write_atomic(file, serde_json::to_string_pretty(&json)?.as_bytes())?;
     let mut problem = Problem::new(load::scene(file)?);
@@ -542,17 +614,13 @@ fn design_variant(
     let params = separate::apply(&plan, &mut problem);
     let mut ws = problem.workspace();
     let start = problem.evaluate(&params, &Weights::default(), &mut ws);
-    let solved = if trial {
-        Some(trial_solve(&plan, file, name, seed)?)
-    } else {
-        None
-    };
     Ok(Variant {
         plan,
+        order,
         moves: sep.moves,
         iou: start.iou,
         clear: start.outcome.n_contacts == 0,
-        solved,
+        solved: None,
     })
 }
 

@@ -194,11 +194,34 @@ impl<'a> Cover<'a> {
     /// Score of a shadow with these samples: the gain, or `None` if it touches an
     /// earlier shadow without the height separation.
     fn score(&self, samples: &[(DVec2, f64)], c: &Candidate, half_height: f64) -> Option<f64> {
+        self.score_above(samples, None, c, half_height)
+    }
+
+    /// [`Cover::score`], given up (`None`) as soon as the gain cannot exceed `floor.1`
+    /// any more, even if every sample left fell on uncovered target: `floor.0[i]` is the
+    /// sum of the weights of the samples from `i` on ([`tails`]). The coarse search
+    /// only keeps candidates above its sixth best, so most of them stop early, and
+    /// those it keeps are scored exactly as [`Cover::score`] scores them.
+    fn score_above(
+        &self,
+        samples: &[(DVec2, f64)],
+        floor: Option<(&[f64], f64)>,
+        c: &Candidate,
+        half_height: f64,
+    ) -> Option<f64> {
         let (w, h) = (self.picture.width, self.picture.height);
         let scale = c.m / self.frame.metres_per_px;
         let px_area = scale * scale;
         let (mut gain, mut touch) = (0.0f64, 0u64);
-        for (d, a) in samples {
+        for (i, (d, a)) in samples.iter().enumerate() {
+            // Every eighth sample, so that the test costs little beside the sum.
+            if i % 8 == 0 {
+                if let Some((tail, floor)) = floor {
+                    if gain + tail[i] * px_area < floor {
+                        return None;
+                    }
+                }
+            }
             let p = to_pixel(c.centre, c.theta, scale, *d);
             let v = if p.x < 0.0 || p.y < 0.0 || p.x >= w as f64 || p.y >= h as f64 {
                 -1.0
@@ -253,6 +276,7 @@ impl<'a> Cover<'a> {
             for alpha in fam.alphas() {
                 let pose = fam.pose(alpha);
                 let samples = pose.outline.samples(COARSE_SAMPLES);
+                let tail = tails(&samples);
                 for (k, &(x, y)) in ridge.iter().enumerate() {
                     let centre = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
                     let thetas: Vec<f64> = if pose.outline.round() {
@@ -271,7 +295,14 @@ impl<'a> Cover<'a> {
                                 m,
                                 alpha,
                             };
-                            if let Some(s) = self.score(&samples, &c, pose.half_height) {
+                            let floor = (kept.len() == KEEP).then(|| {
+                                let f = kept[KEEP - 1].0;
+                                // Below the sixth best by more than rounding: `keep`
+                                // would refuse it.
+                                (tail.as_slice(), f - 1e-9 * f.abs().max(1.0))
+                            });
+                            if let Some(s) = self.score_above(&samples, floor, &c, pose.half_height)
+                            {
                                 keep(&mut kept, (s, fi, c));
                             }
                         }
@@ -800,6 +831,15 @@ impl<'a> Cover<'a> {
             self.undraw(k, &p, &pose);
         }
     }
+}
+
+/// `tails[i]`: the sum of the weights of `samples[i..]` (the last entry is 0).
+fn tails(samples: &[(DVec2, f64)]) -> Vec<f64> {
+    let mut out = vec![0.0; samples.len() + 1];
+    for i in (0..samples.len()).rev() {
+        out[i] = out[i + 1] + samples[i].1.abs();
+    }
+    out
 }
 
 /// Keep the best [`KEEP`] candidates, at most one per nearby centre.

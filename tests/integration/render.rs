@@ -412,24 +412,41 @@ fn new_fly(dir: &Path, extra: &[&str]) -> String {
     out
 }
 
-/// The trial solves' IoUs that `bsa new` printed, and the ceiling it kept.
-fn trials(out: &str) -> (Vec<f64>, Vec<f64>, f64) {
+/// What `bsa new` printed of its trial solves: the ceilings, each order's trial IoUs
+/// (`None` for a design that an earlier order made too, "same") and the ceiling and
+/// order it kept.
+type Trials = (Vec<f64>, Vec<(String, Vec<Option<f64>>)>, (f64, String));
+
+/// The trial solves' line of `bsa new`'s output, parsed ([`Trials`]).
+fn trials(out: &str) -> Trials {
     let line = out
         .lines()
         .find(|l| l.contains("trial solves under ceilings "))
         .unwrap_or_else(|| panic!("{out}"));
-    let list = |after: &str, before: &str| -> Vec<f64> {
-        let s = line
-            .split(after)
-            .nth(1)
-            .unwrap()
-            .split(before)
-            .next()
-            .unwrap();
-        s.split(" / ").map(|v| v.parse().unwrap()).collect()
+    let between = |after: &str, before: &str| -> String {
+        let s = line.split(after).nth(1).unwrap_or_else(|| panic!("{line}"));
+        s.split(before).next().unwrap().to_string()
     };
-    let kept = line.rsplit(' ').next().unwrap().parse().unwrap();
-    (list("ceilings ", " of the"), list("IoU ", ";"), kept)
+    let ceilings = between("ceilings ", " of the")
+        .split(" / ")
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let orders = between("IoU ", ";")
+        .split("), ")
+        .map(|part| {
+            let (ious, label) = part.split_once(" (").unwrap_or_else(|| panic!("{line}"));
+            let ious = ious
+                .split(" / ")
+                .map(|v| (v != "same").then(|| v.parse().unwrap()))
+                .collect();
+            (label.trim_end_matches(')').to_string(), ious)
+        })
+        .collect();
+    let (ceiling, order) = between("kept the design under ", "\n")
+        .split_once(", ")
+        .map(|(c, o)| (c.parse().unwrap(), o.to_string()))
+        .unwrap_or_else(|| panic!("{line}"));
+    (ceilings, orders, (ceiling, order))
 }
 
 #[test]
@@ -439,19 +456,20 @@ fn new_keeps_the_design_that_solves_best_and_solve_ends_where_its_trial_did() {
     let d = tmpdir("new-trials");
     let dir = d.join("fly");
     let out = new_fly(&dir, &[]);
-    let (ceilings, ious, kept) = trials(&out);
+    let (ceilings, orders, (ceiling, order)) = trials(&out);
     assert_eq!(ceilings.len(), 4, "{out}");
-    let best = ious.iter().copied().fold(0.0, f64::max);
-    let at = ceilings.iter().position(|&c| c == kept).unwrap();
-    assert_eq!(ious[at], best, "{out}");
-    // The example in scenes/fly is this design, byte for byte: the examples come from
-    // `bsa new`, and a change of the design shows here until they are made again.
-    let designed = std::fs::read_to_string(dir.join("scene.json")).unwrap();
-    let committed = std::fs::read_to_string(root().join("scenes/fly/scene.json")).unwrap();
-    assert!(
-        designed == committed,
-        "scenes/fly/scene.json is not what `bsa new` designs today: run bash scripts/make-examples.sh"
-    );
+    let labels: Vec<&str> = orders.iter().map(|o| o.0.as_str()).collect();
+    assert_eq!(labels, ["largest object first", "best fit first"], "{out}");
+    // Every design is solved once: the first order's all, the second's where it differs.
+    assert!(orders[0].1.iter().all(Option::is_some), "{out}");
+    assert!(orders.iter().all(|o| o.1.len() == 4), "{out}");
+    let best = orders
+        .iter()
+        .flat_map(|o| o.1.iter().flatten().copied())
+        .fold(0.0, f64::max);
+    let at = ceilings.iter().position(|&c| c == ceiling).unwrap();
+    let kept = orders.iter().find(|o| o.0 == order).unwrap().1[at];
+    assert_eq!(kept, Some(best), "{out}");
     // The written scene is the design that was tried: its solve ends where the trial did.
     let solved = d.join("out");
     solve(&dir, &solved, &[]);
@@ -460,5 +478,13 @@ fn new_keeps_the_design_that_solves_best_and_solve_ends_where_its_trial_did() {
     assert!(
         (iou - best).abs() < 1e-4,
         "solve {iou}, trial {best}: {out}"
+    );
+    // The example in scenes/fly is this design, byte for byte: the examples come from
+    // `bsa new`, and a change of the design shows here until they are made again.
+    let designed = std::fs::read_to_string(dir.join("scene.json")).unwrap();
+    let committed = std::fs::read_to_string(root().join("scenes/fly/scene.json")).unwrap();
+    assert!(
+        designed == committed,
+        "scenes/fly/scene.json is not what `bsa new` designs today: run bash scripts/make-examples.sh"
     );
 }
