@@ -4,7 +4,7 @@
 //! (DejaVu Sans's airplane, chess knight and umbrella symbols), 640 x 480, black on
 //! white, each with the box of objects it is to be made of, stated before any solve.
 //!
-//! Nine sets: set 1 (`tools/test-pictures`), the pictures `bsa new` was developed on;
+//! Ten sets: set 1 (`tools/test-pictures`), the pictures `bsa new` was developed on;
 //! set 2 (`tools/test-pictures-2`), drawn after the code was final and solved once, for
 //! the figures of the issue: letters, digits, outlines, a filled star, a snowman of
 //! discs and two DejaVu symbols (heart and spade) as silhouettes; set 3
@@ -27,9 +27,13 @@
 //! (`tools/test-pictures-9`), drawn after a later session's last design change (the
 //! letter E, lowercase c, i, j, q, the greater-than, dollar, asterisk and slash signs,
 //! the check mark and lightning symbols, a pyramid of six discs, and the shamrock
-//! symbol), its boxes stated as for set 8.
+//! symbol), its boxes stated as for set 8; set 10 (`tools/test-pictures-10`), drawn
+//! after a later session's last design change (lowercase o, the at, parenthesis,
+//! bracket, brace, vertical bar, caret, tilde, colon and semicolon signs, the five of a
+//! die in discs, a bridge of bars, and the female sign and black star symbols), its
+//! boxes stated as for set 8.
 //!
-//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 9,
+//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 10,
 //! default 1; DIR default `tools/test-pictures[-SET]`): writes
 //! `DIR/<name>.png` and `DIR/manifest.tsv` (name, objects, extra `bsa new` options),
 //! which `scripts/new-suite.sh` reads. The output depends only on the font file and
@@ -254,6 +258,51 @@ fn pyramid(x: f64, y: f64) -> bool {
             (x - cx).hypot(y - cy) <= 36.0
         })
     })
+}
+
+fn dice(x: f64, y: f64) -> bool {
+    // The five of a die: four discs of radius 38 at the corners of a square and one in
+    // its middle, apart.
+    let spots = [
+        (-110.0, -110.0),
+        (110.0, -110.0),
+        (0.0, 0.0),
+        (-110.0, 110.0),
+        (110.0, 110.0),
+    ];
+    spots.iter().any(|&(cx, cy)| (x - cx).hypot(y - cy) <= 38.0)
+}
+
+fn bridge(x: f64, y: f64) -> bool {
+    // A deck 400 x 40 px on two pillars 40 x 200 px.
+    let deck = x.abs() <= 200.0 && (60.0..=100.0).contains(&y);
+    let pillar = (120.0..=160.0).contains(&x.abs()) && (-140.0..=60.0).contains(&y);
+    deck || pillar
+}
+
+/// Set 10: defined in a later session after its last change to the design (two orders
+/// of the greedy cover), its objects stated with it as an artist would fill each
+/// picture, and run once.
+fn pictures_10() -> Vec<(&'static str, Shape, String, &'static str)> {
+    let chess_stage = "--width 0.96 --light-height 3";
+    let glyph = |name, c, objects: String| (name, Shape::Glyph(c, 6), objects, "");
+    let chess = |name, c| (name, Shape::Glyph(c, 0), "chess".to_string(), chess_stage);
+    vec![
+        glyph("small-o", 'o', format!("{UNIT}*6")),
+        glyph("at-sign", '@', format!("{UNIT}*10,{HALF}*2")),
+        glyph("paren", '(', format!("{UNIT}*4")),
+        glyph("bracket", '[', format!("{DOUBLE},{UNIT}*3")),
+        glyph("brace", '{', format!("{UNIT}*6")),
+        glyph("pipe", '|', format!("{DOUBLE},{UNIT}")),
+        glyph("caret", '^', format!("{DOUBLE}*2")),
+        glyph("tilde", '~', format!("{UNIT}*4")),
+        glyph("colon", ':', format!("{HALF}*2")),
+        glyph("semicolon", ';', format!("{HALF}*2,{UNIT}")),
+        ("dice", Shape::Drawn(dice), "sphere:0.07*5".to_string(), ""),
+        ("bridge", Shape::Drawn(bridge), format!("{DOUBLE}*4"), ""),
+        chess("female", '\u{2640}'),
+        chess("black-star", '\u{2605}'),
+    ]
 }
 
 /// Set 9: defined in a later session after its last change to the design (leaning
@@ -782,7 +831,8 @@ fn main() -> Result<(), Box<dyn Error>> {
         "7" => (pictures_7(), "tools/test-pictures-7"),
         "8" => (pictures_8(), "tools/test-pictures-8"),
         "9" => (pictures_9(), "tools/test-pictures-9"),
-        other => return Err(format!("SET must be 1 to 9, got {other:?}").into()),
+        "10" => (pictures_10(), "tools/test-pictures-10"),
+        other => return Err(format!("SET must be 1 to 10, got {other:?}").into()),
     };
     let dir = args
         .get(1)
