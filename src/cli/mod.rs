@@ -363,10 +363,10 @@ struct NewArgs {
     /// The picture (PNG; dark = shadow).
     #[arg(long, value_name = "PNG")]
     target: PathBuf,
-    /// How to choose among the designs made under the four ceilings: `solve` solves
-    /// each as `bsa solve` will (the scene's seed) and keeps the best picture,
-    /// contact-free first (about four solves' work, on every core); `start` keeps the
-    /// best start guess (no solve).
+    /// How to choose among the designs made under the four ceilings in the two orders:
+    /// `solve` solves each that differs as `bsa solve` will (the scene's seed) and keeps
+    /// the best picture, contact-free first (up to eight solves' work, on every core);
+    /// `start` keeps the best start guess (no solve).
     #[arg(long, value_enum, default_value_t = new::ChooseBy::Solve)]
     choose_by: new::ChooseBy,
     #[command(flatten)]
