@@ -337,15 +337,20 @@ pub(super) fn run(opts: &Options) -> Result<()> {
                 ceiling,
                 ..geometry.clone()
             };
-            let variant = design_variant(
-                &picture,
-                geometry,
-                &request,
-                order,
-                &design_files[k],
-                &name,
-                opts.seed,
-            );
+            // After a Ctrl-C the designs not begun are skipped too.
+            let variant = if INTERRUPTS.load(Ordering::SeqCst) > 0 {
+                Err(anyhow::anyhow!("interrupted"))
+            } else {
+                design_variant(
+                    &picture,
+                    geometry,
+                    &request,
+                    order,
+                    &design_files[k],
+                    &name,
+                    opts.seed,
+                )
+            };
             bar.inc(1);
             variant
         })
@@ -376,7 +381,13 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             .par_iter()
             .map(|&k| {
                 let v = designed[k].as_ref().expect("a design to solve");
-                let s = trial_solve(&v.plan, &design_files[k], &name, opts.seed);
+                // After a Ctrl-C nothing is written: the trials not begun are skipped
+                // (one begun stops at once, its solver watching the same counter).
+                let s = if INTERRUPTS.load(Ordering::SeqCst) > 0 {
+                    Err(anyhow::anyhow!("interrupted"))
+                } else {
+                    trial_solve(&v.plan, &design_files[k], &name, opts.seed)
+                };
                 bar.inc(1);
                 (k, s)
             })
