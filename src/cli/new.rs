@@ -329,7 +329,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             design::ORDERS.len()
         ),
     );
-    let designed: Vec<Result<Variant>> = settings
+    let mut designed: Vec<Result<Variant>> = settings
         .par_iter()
         .enumerate()
         .map(|(k, &(order, ceiling))| {
@@ -337,10 +337,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
                 ceiling,
                 ..geometry.clone()
             };
-            // After a Ctrl-C the designs not begun are skipped too.
-            let variant = if INTERRUPTS.load(Ordering::SeqCst) > 0 {
-                Err(anyhow::anyhow!("interrupted"))
-            } else {
+            let variant = unless_interrupted(|| {
                 design_variant(
                     &picture,
                     geometry,
@@ -350,7 +347,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
                     &name,
                     opts.seed,
                 )
-            };
+            });
             bar.inc(1);
             variant
         })
@@ -371,7 +368,6 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let same_as: Vec<Option<usize>> = (0..designed.len())
         .map(|k| (0..k).find(|&j| scenes[k].is_some() && scenes[j] == scenes[k]))
         .collect();
-    let mut designed = designed;
     if trial {
         let todo: Vec<usize> = (0..designed.len())
             .filter(|&k| designed[k].is_ok() && same_as[k].is_none())
@@ -381,13 +377,9 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             .par_iter()
             .map(|&k| {
                 let v = designed[k].as_ref().expect("a design to solve");
-                // After a Ctrl-C nothing is written: the trials not begun are skipped
-                // (one begun stops at once, its solver watching the same counter).
-                let s = if INTERRUPTS.load(Ordering::SeqCst) > 0 {
-                    Err(anyhow::anyhow!("interrupted"))
-                } else {
-                    trial_solve(&v.plan, &design_files[k], &name, opts.seed)
-                };
+                // One begun stops at once: its solver watches the same counter.
+                let s =
+                    unless_interrupted(|| trial_solve(&v.plan, &design_files[k], &name, opts.seed));
                 bar.inc(1);
                 (k, s)
             })
@@ -497,6 +489,15 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         eprintln!("{name}: note: {note}");
     }
     Ok(())
+}
+
+/// `work()`, unless Ctrl-C was pressed: after it nothing is written, so the designs and
+/// trial solves not yet begun are skipped.
+fn unless_interrupted<T>(work: impl FnOnce() -> Result<T>) -> Result<T> {
+    if INTERRUPTS.load(Ordering::SeqCst) > 0 {
+        bail!("interrupted");
+    }
+    work()
 }
 
 /// Share of the target the start guess leaves bare (0 to 1) from which, with a final

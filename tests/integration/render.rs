@@ -172,21 +172,26 @@ fn plant_refuses_bad_inventories_and_ones_that_cannot_fit() {
     }
 }
 
-#[test]
-fn new_designs_a_scene_that_solve_takes_as_it_is() {
-    let d = tmpdir("new");
-    let dir = d.join("mickey");
+/// `bsa new DIR` of Mickey's target (a 4 m picture) with `objects`: (success, stdout,
+/// stderr).
+fn new_mickey(dir: &Path, objects: &str) -> (bool, String, String) {
     let target = root().join("scenes/mickey/target.png");
-    let (ok, out, err) = bsa(&[
+    bsa(&[
         "new",
         dir.to_str().unwrap(),
         "--target",
         target.to_str().unwrap(),
         "--objects",
-        "sphere:0.6,sphere:0.35*2",
+        objects,
         "--width",
         "4",
-    ]);
+    ])
+}
+
+#[test]
+fn new_designs_a_scene_that_solve_takes_as_it_is() {
+    let dir = tmpdir("new").join("mickey");
+    let (ok, out, err) = new_mickey(&dir, "sphere:0.6,sphere:0.35*2");
     assert!(ok && out.contains("start guess IoU"), "{err}");
     // Three spheres for Mickey's three discs: nothing to note.
     assert!(!err.contains("note:"), "{err}");
@@ -205,19 +210,8 @@ fn new_designs_a_scene_that_solve_takes_as_it_is() {
 fn new_tells_when_the_objects_cannot_cover_the_picture() {
     // One small sphere for Mickey's head and two ears: most of the picture stays bare
     // whatever the solve does, and the user is told what to bring.
-    let d = tmpdir("new-few");
-    let dir = d.join("mickey");
-    let target = root().join("scenes/mickey/target.png");
-    let (ok, _, err) = bsa(&[
-        "new",
-        dir.to_str().unwrap(),
-        "--target",
-        target.to_str().unwrap(),
-        "--objects",
-        "sphere:0.35",
-        "--width",
-        "4",
-    ]);
+    let dir = tmpdir("new-few").join("mickey");
+    let (ok, _, err) = new_mickey(&dir, "sphere:0.35");
     assert!(ok, "{err}");
     assert!(
         err.contains("note: the objects leave") && err.contains("% of the picture bare"),
