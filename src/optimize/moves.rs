@@ -10,7 +10,10 @@
 //!   light, at the depth where its own shadow has the other's area, so that the picture
 //!   is unchanged up to the two shapes; or each is sent to the other's place in space;
 //!   or, where both bodies' parts are known (see `fit`), each to the other's part at the
-//!   part's whole size;
+//!   part's whole size; or, for two bodies of one kind and different shapes, each to the
+//!   other's pose at `t` and place (an **exchange**, [`MoveReport::exchanges`]: rarely
+//!   better as it stands, so the solver also refines the best few before it judges
+//!   them);
 //! - **fill** the largest bare part of the target with body `i`: sent to the line of
 //!   sight through the part's centroid, at the depth where its shadow has the part's
 //!   area, and, if it is not a sphere and the part is elongated, also laid along the
@@ -113,6 +116,23 @@ pub struct MoveReport {
     /// and a lower energy than the launch kept: a better picture that a local search
     /// may free of its contact (the caller may start a run from it).
     pub promising: Option<Vec<f64>>,
+    /// The exchanges of pose and place of two bodies of one kind and different shapes
+    /// (see [`improve`]) from the launch kept, each after [`Search::polish`], best
+    /// picture first: rarely better as they stand (each body is off its new part by a
+    /// little), they are worth a short local search of the two bodies. Empty when the
+    /// last pass took a move.
+    pub exchanges: Vec<Exchange>,
+    /// The energy of the launch kept without the contact term (as [`Exchange::free`]).
+    pub kept_free: f64,
+}
+
+/// Two bodies that took each other's pose and place.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Exchange {
+    pub launch: Vec<f64>,
+    pub bodies: [usize; 2],
+    /// Its energy without the contact term.
+    pub free: f64,
 }
 
 /// Depth changes tried for a moved body, one after the other (fractions of its depth
@@ -250,6 +270,7 @@ pub fn improve(
     let mut candidate = params.to_vec();
     let mut chosen = params.to_vec();
     let mut flight = FreeFlight::default();
+    let mut exchanges: Vec<Exchange> = Vec::new();
     for _ in 0..options.max_moves {
         let current = problem.evaluate_held(held, params, weights, ws);
         // The orientations at `t` of the launch kept (the offers below overwrite `ws`).
@@ -264,6 +285,7 @@ pub fn improve(
         let mut found = None;
         // Every move of the pass, evaluated; the best few are then polished.
         let mut offers: Vec<Offer> = Vec::new();
+        exchanges.clear();
         let mut offer =
             |candidate: &[f64], bodies: &[usize], search: &mut Search, ws: &mut Workspace| {
                 let eval = search.evaluate(candidate, ws);
@@ -299,6 +321,49 @@ pub fn improve(
                     send_to_part(problem, &mut candidate, i, si, part_j);
                     send_to_part(problem, &mut candidate, j, sj, part_i);
                     offer(&candidate, &[i, j], &mut search, ws);
+                }
+                // ... or each takes the other's pose too: two bodies of one family in
+                // the same kind of pose (a king and a bishop lying down) often end each
+                // drawing the other's shadow at the other's size, which no swap that
+                // keeps the poses reproduces.
+                if let (Some(ci), Some(cj)) = (
+                    canonical(&scene.occluders[i].shape),
+                    canonical(&scene.occluders[j].shape),
+                ) {
+                    if kind_of(&scene.occluders[i].shape) == kind_of(&scene.occluders[j].shape)
+                        && scene.occluders[i].shape != scene.occluders[j].shape
+                    {
+                        candidate.copy_from_slice(params);
+                        let ratio =
+                            scene.occluders[i].bounding_radius / scene.occluders[j].bounding_radius;
+                        let want_i = turned[j] * cj * ci.conjugate();
+                        let want_j = turned[i] * ci * cj.conjugate();
+                        for (b, now, want) in [(i, turned[i], want_i), (j, turned[j], want_j)] {
+                            let rotation = (want * now.conjugate()).to_axis_angle();
+                            turn_spin(problem, &mut candidate, b, now, rotation, true, &mut flight);
+                        }
+                        // Each in the other's pose and on its line of sight, at the depth
+                        // where its shadow has the other's size (as their sizes go).
+                        let as_j = Sight {
+                            area: sj.area * ratio * ratio,
+                            ..sj
+                        };
+                        let as_i = Sight {
+                            area: si.area / (ratio * ratio),
+                            ..si
+                        };
+                        send(problem, &mut candidate, i, sj.on_receiver, as_j, sj.area);
+                        send(problem, &mut candidate, j, si.on_receiver, as_i, si.area);
+                        let e = search.evaluate(&candidate, ws);
+                        let mut launch = candidate.clone();
+                        let e = search.polish(&mut launch, e, &[i, j], ws);
+                        offer(&launch, &[i, j], &mut search, ws);
+                        exchanges.push(Exchange {
+                            launch,
+                            bodies: [i, j],
+                            free: search.free(&e),
+                        });
+                    }
                 }
             }
         }
@@ -414,6 +479,8 @@ pub fn improve(
                 params.copy_from_slice(&chosen);
                 *best = e;
                 report.accepted += 1;
+                // Exchanges of the launch before this move are stale.
+                exchanges.clear();
             }
             None => break,
         }
@@ -422,6 +489,9 @@ pub fn improve(
     *best = problem.evaluate_held(held, params, weights, ws);
     report.samples = search.samples;
     let kept = search.free(best);
+    exchanges.sort_by(|a, b| a.free.total_cmp(&b.free));
+    report.exchanges = exchanges;
+    report.kept_free = kept;
     report.promising = search
         .promising
         .filter(|(energy, _)| *energy < kept)
@@ -737,6 +807,36 @@ fn lays(problem: &Problem, i: usize, now: DQuat, com: DVec3, angle: f64) -> Vec<
         .collect()
 }
 
+/// The rotation from a body's canonical frame to its own (body) frame, for a swap of
+/// poses: a mesh's own frame (the pieces of one set share a convention: upright along
+/// one axis, base at the origin), a box's axes sorted from the longest (x) to the
+/// shortest (z); `None` for a sphere, whose pose shows nothing.
+fn canonical(shape: &Shape) -> Option<DQuat> {
+    match shape {
+        Shape::Sphere { .. } => None,
+        Shape::Mesh(_) => Some(DQuat::IDENTITY),
+        Shape::Cuboid { half_extents } => {
+            let h = half_extents.to_array();
+            let mut order = [0usize, 1, 2];
+            order.sort_by(|&a, &b| h[b].total_cmp(&h[a]).then(a.cmp(&b)));
+            let axis =
+                |k: usize| DVec3::from_array(std::array::from_fn(|c| f64::from(u8::from(c == k))));
+            let (x, y) = (axis(order[0]), axis(order[1]));
+            // A right-handed frame: a box is symmetric under the sign of its third axis.
+            Some(DQuat::from_mat3(&DMat3::from_cols(x, y, x.cross(y))))
+        }
+    }
+}
+
+/// The kind of a shape, for [`canonical`] frames that mean the same across bodies.
+fn kind_of(shape: &Shape) -> u8 {
+    match shape {
+        Shape::Sphere { .. } => 0,
+        Shape::Cuboid { .. } => 1,
+        Shape::Mesh(_) => 2,
+    }
+}
+
 /// The body-frame direction of a body's long axis: the principal axis of least inertia.
 fn long_body_axis(mass: &crate::geometry::shape::MassProperties) -> DVec3 {
     let k = mass.principal_inertia;
@@ -753,6 +853,19 @@ fn long_body_axis(mass: &crate::geometry::shape::MassProperties) -> DVec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_box_canonical_frame_runs_from_its_longest_axis_to_its_shortest() {
+        let shape = Shape::Cuboid {
+            half_extents: DVec3::new(0.035, 0.14, 0.0175),
+        };
+        let q = canonical(&shape).expect("a box has a frame");
+        assert!((q * DVec3::X - DVec3::Y).length() < 1e-12);
+        assert!((q * DVec3::Y - DVec3::X).length() < 1e-12);
+        // A proper rotation: the third axis is the shortest, either way along it.
+        assert!(((q * DVec3::Z).dot(DVec3::Z).abs() - 1.0).abs() < 1e-12);
+        assert!(canonical(&Shape::Sphere { radius: 0.1 }).is_none());
+    }
 
     #[test]
     fn long_axis_gives_the_angle_of_an_elongated_blob() {

@@ -322,6 +322,12 @@ fn planted_pair(name: &str) -> (Problem, Vec<f64>) {
 /// A planted problem of the spheres `objects` (`bsa plant`): its problem and the planted
 /// launch.
 fn planted_spheres(name: &str, objects: &str) -> (Problem, Vec<f64>) {
+    planted(name, objects, "4")
+}
+
+/// A planted problem of `objects` on a picture `width` metres wide (`bsa plant`, seed
+/// 3): its problem and the planted launch.
+fn planted(name: &str, objects: &str, width: &str) -> (Problem, Vec<f64>) {
     let dir = crate::util::tmpdir(name).join("pair");
     let (ok, _, err) = crate::util::bsa(&[
         "plant",
@@ -331,7 +337,7 @@ fn planted_spheres(name: &str, objects: &str) -> (Problem, Vec<f64>) {
         "--seed",
         "3",
         "--width",
-        "4",
+        width,
     ]);
     assert!(ok, "{err}");
     let p = Problem::new(bsa::scene::load(&dir).unwrap());
@@ -402,6 +408,46 @@ fn run_moves(
         &mut |_| {},
     );
     (before, best, report)
+}
+
+#[test]
+fn exchanges_give_two_blocks_each_others_pose_and_place() {
+    // Two blocks of different lengths, planted: IoU 1 with each on its own part.
+    let (p, planted) = planted(
+        "moves-exchange",
+        "box:0.28x0.07x0.035,box:0.14x0.07x0.035",
+        "1.6",
+    );
+    let w = p.scene.stages.last().unwrap().weights;
+    let mut ws = p.workspace();
+    let iou = |params: &[f64], ws: &mut bsa::evaluate::Workspace| p.evaluate(params, &w, ws).iou;
+    assert!(iou(&planted, &mut ws) > 0.9999);
+    // From the planted launch, the exchange puts the long block in the short one's pose
+    // on its part and the other way round: a worse picture, as the two shapes differ.
+    let mut params = planted.clone();
+    let (_, best, report) = run_moves(&p, &mut params, &contact_free_first);
+    assert_eq!(report.accepted, 0, "{report:?}");
+    assert!(best.iou > 0.9999);
+    let swapped = report
+        .exchanges
+        .first()
+        .expect("an exchange of the two blocks");
+    assert_eq!(swapped.bodies, [0, 1]);
+    let wrong = iou(&swapped.launch, &mut ws);
+    assert!(wrong < 0.95, "IoU of the exchange {wrong}");
+    // From the wrong pairing, the exchange brings each block back to its own part in
+    // (about) its own pose.
+    let mut params = swapped.launch.clone();
+    let (before, best, report) = run_moves(&p, &mut params, &contact_free_first);
+    let back = report
+        .exchanges
+        .iter()
+        .map(|x| iou(&x.launch, &mut ws))
+        .fold(best.iou, f64::max);
+    assert!(
+        back > before + 0.05 && back > 0.9,
+        "IoU {before} -> {back} ({report:?})"
+    );
 }
 
 #[test]
