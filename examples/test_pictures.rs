@@ -4,7 +4,7 @@
 //! (DejaVu Sans's airplane, chess knight and umbrella symbols), 640 x 480, black on
 //! white, each with the box of objects it is to be made of, stated before any solve.
 //!
-//! Ten sets: set 1 (`tools/test-pictures`), the pictures `bsa new` was developed on;
+//! Eleven sets: set 1 (`tools/test-pictures`), the pictures `bsa new` was developed on;
 //! set 2 (`tools/test-pictures-2`), drawn after the code was final and solved once, for
 //! the figures of the issue: letters, digits, outlines, a filled star, a snowman of
 //! discs and two DejaVu symbols (heart and spade) as silhouettes; set 3
@@ -31,9 +31,12 @@
 //! after a later session's last design change (lowercase o, the at, parenthesis,
 //! bracket, brace, vertical bar, caret, tilde, colon and semicolon signs, the five of a
 //! die in discs, a bridge of bars, and the female sign and black star symbols), its
-//! boxes stated as for set 8.
+//! boxes stated as for set 8; set 11 (`tools/test-pictures-11`), drawn after a later
+//! session's last solver change (the Greek capitals sigma, pi, delta, xi, lambda and
+//! omega, the double quote, the heavy X, arrow, male sign and house symbols, a ring of
+//! six discs, and the cloud and shogi-piece symbols), its boxes stated as for set 8.
 //!
-//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 10,
+//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 11,
 //! default 1; DIR default `tools/test-pictures[-SET]`): writes
 //! `DIR/<name>.png` and `DIR/manifest.tsv` (name, objects, extra `bsa new` options),
 //! which `scripts/new-suite.sh` reads. The output depends only on the font file and
@@ -278,6 +281,39 @@ fn bridge(x: f64, y: f64) -> bool {
     let deck = x.abs() <= 200.0 && (60.0..=100.0).contains(&y);
     let pillar = (120.0..=160.0).contains(&x.abs()) && (-140.0..=60.0).contains(&y);
     deck || pillar
+}
+
+fn hexagon_ring(x: f64, y: f64) -> bool {
+    // Six discs of radius 36 on a circle of radius 150, evenly spaced.
+    (0..6).any(|k| {
+        let a = k as f64 * std::f64::consts::PI / 3.0;
+        (x - 150.0 * a.cos()).hypot(y - 150.0 * a.sin()) <= 36.0
+    })
+}
+
+/// Set 11: defined in a later session after its last change to the solver (exchanges
+/// of pose and place), its objects stated with it as an artist would fill each
+/// picture, and run once.
+fn pictures_11() -> Vec<(&'static str, Shape, String, &'static str)> {
+    let chess_stage = "--width 0.96 --light-height 3";
+    let glyph = |name, c, objects: String| (name, Shape::Glyph(c, 6), objects, "");
+    let chess = |name, c| (name, Shape::Glyph(c, 0), "chess".to_string(), chess_stage);
+    vec![
+        glyph("sigma", '\u{03A3}', format!("{DOUBLE}*4")),
+        glyph("pi", '\u{03A0}', format!("{DOUBLE}*3")),
+        glyph("delta", '\u{0394}', format!("{DOUBLE}*3")),
+        glyph("xi", '\u{039E}', format!("{DOUBLE}*3")),
+        glyph("lambda", '\u{039B}', format!("{DOUBLE}*2")),
+        glyph("omega", '\u{03A9}', format!("{UNIT}*8,{HALF}*2")),
+        glyph("quote", '"', format!("{DOUBLE}*2")),
+        glyph("heavy-x", '\u{2716}', format!("{DOUBLE}*4")),
+        glyph("arrow", '\u{279C}', format!("{DOUBLE},{UNIT}*2")),
+        glyph("male", '\u{2642}', format!("{UNIT}*8,{HALF}*2")),
+        glyph("house", '\u{2302}', format!("{DOUBLE}*3,{UNIT}*2")),
+        ("disc-ring", Shape::Drawn(hexagon_ring), "sphere:0.07*6".to_string(), ""),
+        chess("cloud", '\u{2601}'),
+        chess("shogi", '\u{2617}'),
+    ]
 }
 
 /// Set 10: defined in a later session after its last change to the design (two orders
@@ -832,7 +868,8 @@ fn main() -> Result<(), Box<dyn Error>> {
         "8" => (pictures_8(), "tools/test-pictures-8"),
         "9" => (pictures_9(), "tools/test-pictures-9"),
         "10" => (pictures_10(), "tools/test-pictures-10"),
-        other => return Err(format!("SET must be 1 to 10, got {other:?}").into()),
+        "11" => (pictures_11(), "tools/test-pictures-11"),
+        other => return Err(format!("SET must be 1 to 11, got {other:?}").into()),
     };
     let dir = args
         .get(1)
