@@ -310,7 +310,12 @@ fn pictures_11() -> Vec<(&'static str, Shape, String, &'static str)> {
         glyph("arrow", '\u{279C}', format!("{DOUBLE},{UNIT}*2")),
         glyph("male", '\u{2642}', format!("{UNIT}*8,{HALF}*2")),
         glyph("house", '\u{2302}', format!("{DOUBLE}*3,{UNIT}*2")),
-        ("disc-ring", Shape::Drawn(hexagon_ring), "sphere:0.07*6".to_string(), ""),
+        (
+            "disc-ring",
+            Shape::Drawn(hexagon_ring),
+            "sphere:0.07*6".to_string(),
+            "",
+        ),
         chess("cloud", '\u{2601}'),
         chess("shogi", '\u{2617}'),
     ]

@@ -325,21 +325,14 @@ pub fn solve(
                     polish_single: restart > 0 || stage.vary.len() > 1,
                 },
                 &mut ws,
-                &mut |e: &Evaluation| {
-                    records.push(SampleRecord {
-                        stage: k,
-                        iteration,
-                        terms: e.weighted(&stage.weights),
-                        total: e.total,
-                    })
-                },
+                &mut |e: &Evaluation| records.push(sample_record(k, iteration, stage, e)),
             );
             samples += moved.samples;
             if moved.accepted > 0 {
                 best_mask.copy_from(&ws.mask);
             }
-            // Exchanges of two bodies' poses and places, each refined by a short search
-            // of the two alone, before the stage's first run (see `exchange`).
+            // Exchanges of two bodies' poses and places, each refined by rounds of
+            // one-body runs, before the stage's first run (see `exchange`).
             let template = scene.stages.iter().rev().find(|s| s.vary.len() == 1);
             if let Some(template) = template.filter(|_| restart == 0 && !robust) {
                 let better = exchange(
@@ -349,14 +342,7 @@ pub fn solve(
                     &moved,
                     rank_value(&best_eval, scene.contacts),
                     stage_seed(seed, k),
-                    &mut |e: &Evaluation| {
-                        records.push(SampleRecord {
-                            stage: k,
-                            iteration,
-                            terms: e.weighted(&stage.weights),
-                            total: e.total,
-                        })
-                    },
+                    &mut |e: &Evaluation| records.push(sample_record(k, iteration, stage, e)),
                 );
                 samples += better.1;
                 if let Some(launch) = better.0 {
@@ -399,12 +385,7 @@ pub fn solve(
                 let mut improved = None;
                 for (j, e) in evals.iter().enumerate() {
                     fitness[j] = rank_value(e, scene.contacts);
-                    records.push(SampleRecord {
-                        stage: k,
-                        iteration,
-                        terms: e.weighted(&stage.weights),
-                        total: e.total,
-                    });
+                    records.push(sample_record(k, iteration, stage, e));
                     if !robust && fitness[j] < rank_value(&best_eval, scene.contacts) {
                         best_eval = *e;
                         improved = Some(j);
@@ -535,6 +516,16 @@ pub fn solve(
     };
     let s = summarize(problem, &params, &reports, &run, Some(timing));
     (s, records)
+}
+
+/// The record of one sample of stage `k` (`stage`) at `iteration`.
+fn sample_record(k: usize, iteration: usize, stage: &Stage, e: &Evaluation) -> SampleRecord {
+    SampleRecord {
+        stage: k,
+        iteration,
+        terms: e.weighted(&stage.weights),
+        total: e.total,
+    }
 }
 
 /// Exchanges of a joint stage's moves that are refined, at most: those whose pictures
