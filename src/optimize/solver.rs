@@ -335,11 +335,14 @@ pub fn solve(
             // one-body runs, before the stage's first run (see `exchange`).
             let template = scene.stages.iter().rev().find(|s| s.vary.len() == 1);
             if let Some(template) = template.filter(|_| restart == 0 && !robust) {
+                // What the solve drew before this stage, and the stage so far.
+                let drawn = reports.iter().map(|r| r.samples).sum::<usize>() + samples;
                 let better = exchange(
                     problem,
                     &pool,
                     template,
                     &moved,
+                    EXCHANGE_SHARE * drawn as f64,
                     rank_value(&best_eval, scene.contacts),
                     stage_seed(seed, k),
                     &mut |e: &Evaluation| records.push(sample_record(k, iteration, stage, e)),
@@ -537,10 +540,17 @@ const EXCHANGE_TRIALS: usize = 4;
 /// little off their new parts.
 const EXCHANGE_RATIO: f64 = 4.0;
 
+/// The exchanges of a stage draw at most this share of the samples the solve drew before
+/// them (a trial starts only while its first round fits): they are a last resort, and on
+/// a small solve they would cost more than the solve (the hand-made "to fly" draws
+/// 22,000 samples in all, and four trials 15,000 more).
+const EXCHANGE_SHARE: f64 = 0.15;
+
 /// Refine the best exchanges that `moved` offers (see [`moves::MoveReport::exchanges`])
 /// as two rounds of the sequential strategy would: each of the two bodies alone, one
 /// after the other, by a CMA-ES run with the settings of `template` (the scene's last
-/// stage of one body), twice. In the first round the two ignore their contacts with each
+/// stage of one body), twice; a trial starts only while its first round fits in `budget`
+/// samples ([`EXCHANGE_SHARE`]). In the first round the two ignore their contacts with each
 /// other: their new flights often cross (each now flies from its own slot to the
 /// other's part), and a run that must first get out of that contact moves its body off
 /// the picture; the second round counts every contact again. Returns the best refined
@@ -553,13 +563,16 @@ const EXCHANGE_RATIO: f64 = 4.0;
 /// and only its refinement shows whether the other pairing is the better one. A joint
 /// run of the two bodies refined worse than runs of one body each: on the planted chess
 /// problems of seeds 9805 and 9802 it ended above the exchange it started from, where
-/// the rounds of one body took the pictures from 0.965 to 0.986 and from 0.961 to 0.972.
+/// the rounds of one body took the pictures from 0.965 to 0.986 and from 0.961 to 0.972
+/// (with four trials; under the budget, the first problem's exchange, the third best
+/// picture, is no longer tried).
 #[allow(clippy::too_many_arguments)]
 fn exchange(
     problem: &Problem,
     pool: &Pool,
     template: &Stage,
     moved: &moves::MoveReport,
+    budget: f64,
     kept: f64,
     seed: u64,
     record: &mut dyn FnMut(&Evaluation),
@@ -571,7 +584,12 @@ fn exchange(
         .iter()
         .filter(|x| x.free < EXCHANGE_RATIO * moved.kept_free)
         .take(EXCHANGE_TRIALS);
+    // A trial's first round: two runs of one body at most.
+    let round = (2 * template.max_iterations * template.population) as f64;
     for (t, x) in trials.enumerate() {
+        if samples as f64 + round > budget {
+            break;
+        }
         let mut launch = x.launch.clone();
         let mut rank = f64::INFINITY;
         for (g, &body) in x.bodies.iter().cycle().take(4).enumerate() {
