@@ -4,7 +4,7 @@
 //! (DejaVu Sans's airplane, chess knight and umbrella symbols), 640 x 480, black on
 //! white, each with the box of objects it is to be made of, stated before any solve.
 //!
-//! Eleven sets: set 1 (`tools/test-pictures`), the pictures `bsa new` was developed on;
+//! Twelve sets: set 1 (`tools/test-pictures`), the pictures `bsa new` was developed on;
 //! set 2 (`tools/test-pictures-2`), drawn after the code was final and solved once, for
 //! the figures of the issue: letters, digits, outlines, a filled star, a snowman of
 //! discs and two DejaVu symbols (heart and spade) as silhouettes; set 3
@@ -34,9 +34,14 @@
 //! boxes stated as for set 8; set 11 (`tools/test-pictures-11`), drawn after a later
 //! session's last solver change (the Greek capitals sigma, pi, delta, xi, lambda and
 //! omega, the double quote, the heavy X, arrow, male sign and house symbols, a ring of
-//! six discs, and the cloud and shogi-piece symbols), its boxes stated as for set 8.
+//! six discs, and the cloud and shogi-piece symbols), its boxes stated as for set 8;
+//! set 12 (`tools/test-pictures-12`), drawn after the same session's budget for the
+//! exchanges (the Greek capitals gamma, theta, phi and psi, the Cyrillic zhe and sha,
+//! the closing brace and parenthesis, the comma, the heavy cross and envelope symbols,
+//! an arc of five discs, and the telephone and heavy heart symbols), its boxes stated
+//! as for set 8.
 //!
-//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 11,
+//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 12,
 //! default 1; DIR default `tools/test-pictures[-SET]`): writes
 //! `DIR/<name>.png` and `DIR/manifest.tsv` (name, objects, extra `bsa new` options),
 //! which `scripts/new-suite.sh` reads. The output depends only on the font file and
@@ -289,6 +294,40 @@ fn hexagon_ring(x: f64, y: f64) -> bool {
         let a = k as f64 * std::f64::consts::PI / 3.0;
         (x - 150.0 * a.cos()).hypot(y - 150.0 * a.sin()) <= 36.0
     })
+}
+
+fn disc_arc(x: f64, y: f64) -> bool {
+    // Five discs of radius 34 on an arc of radius 220 about a centre below the frame,
+    // from 50 to 130 degrees.
+    (0..5).any(|k| {
+        let a = (50.0 + 20.0 * k as f64).to_radians();
+        (x - 220.0 * a.cos()).hypot(y + 120.0 - 220.0 * a.sin()) <= 34.0
+    })
+}
+
+/// Set 12: defined in a later session after its last change to the solver (a budget
+/// for the exchanges), its objects stated with it as an artist would fill each picture,
+/// and run once.
+fn pictures_12() -> Vec<(&'static str, Shape, String, &'static str)> {
+    let chess_stage = "--width 0.96 --light-height 3";
+    let glyph = |name, c, objects: String| (name, Shape::Glyph(c, 6), objects, "");
+    let chess = |name, c| (name, Shape::Glyph(c, 0), "chess".to_string(), chess_stage);
+    vec![
+        glyph("gamma", '\u{0393}', format!("{DOUBLE}*2")),
+        glyph("theta", '\u{0398}', format!("{UNIT}*9")),
+        glyph("phi", '\u{03A6}', format!("{DOUBLE},{UNIT}*6")),
+        glyph("psi", '\u{03A8}', format!("{DOUBLE},{UNIT}*5")),
+        glyph("zhe", '\u{0416}', format!("{DOUBLE},{UNIT}*4")),
+        glyph("sha", '\u{0428}', format!("{DOUBLE}*4")),
+        glyph("close-brace", '}', format!("{UNIT}*6")),
+        glyph("close-paren", ')', format!("{UNIT}*4")),
+        glyph("comma", ',', format!("{UNIT}*3")),
+        glyph("heavy-cross", '\u{271A}', format!("{DOUBLE}*4")),
+        glyph("envelope", '\u{2709}', format!("{DOUBLE}*4,{UNIT}*4")),
+        ("disc-arc", Shape::Drawn(disc_arc), "sphere:0.07*5".to_string(), ""),
+        chess("telephone", '\u{260E}'),
+        chess("heavy-heart", '\u{2764}'),
+    ]
 }
 
 /// Set 11: defined in a later session after its last change to the solver (exchanges
@@ -874,7 +913,8 @@ fn main() -> Result<(), Box<dyn Error>> {
         "9" => (pictures_9(), "tools/test-pictures-9"),
         "10" => (pictures_10(), "tools/test-pictures-10"),
         "11" => (pictures_11(), "tools/test-pictures-11"),
-        other => return Err(format!("SET must be 1 to 11, got {other:?}").into()),
+        "12" => (pictures_12(), "tools/test-pictures-12"),
+        other => return Err(format!("SET must be 1 to 12, got {other:?}").into()),
     };
     let dir = args
         .get(1)
