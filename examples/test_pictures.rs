@@ -324,7 +324,12 @@ fn pictures_12() -> Vec<(&'static str, Shape, String, &'static str)> {
         glyph("comma", ',', format!("{UNIT}*3")),
         glyph("heavy-cross", '\u{271A}', format!("{DOUBLE}*4")),
         glyph("envelope", '\u{2709}', format!("{DOUBLE}*4,{UNIT}*4")),
-        ("disc-arc", Shape::Drawn(disc_arc), "sphere:0.07*5".to_string(), ""),
+        (
+            "disc-arc",
+            Shape::Drawn(disc_arc),
+            "sphere:0.07*5".to_string(),
+            "",
+        ),
         chess("telephone", '\u{260E}'),
         chess("heavy-heart", '\u{2764}'),
     ]
