@@ -333,46 +333,27 @@ pub fn improve(
                     send_to_part(problem, &mut candidate, j, sj, part_i);
                     offer(&candidate, &[i, j], &mut search, ws);
                 }
-                // ... or each takes the other's pose too: two bodies of one family in
-                // the same kind of pose (a king and a bishop lying down) often end each
-                // drawing the other's shadow at the other's size, which no swap that
-                // keeps the poses reproduces.
-                if let (Some(ci), Some(cj)) = (
-                    canonical(&scene.occluders[i].shape),
-                    canonical(&scene.occluders[j].shape),
-                ) {
-                    if exchanges_wanted && exchangeable(scene, i, j) {
-                        candidate.copy_from_slice(params);
-                        let ratio =
-                            scene.occluders[i].bounding_radius / scene.occluders[j].bounding_radius;
-                        let want_i = turned[j] * cj * ci.conjugate();
-                        let want_j = turned[i] * ci * cj.conjugate();
-                        for (b, now, want) in [(i, turned[i], want_i), (j, turned[j], want_j)] {
-                            let rotation = (want * now.conjugate()).to_axis_angle();
-                            turn_spin(problem, &mut candidate, b, now, rotation, true, &mut flight);
-                        }
-                        // Each in the other's pose and on its line of sight, at the depth
-                        // where its shadow has the other's size (as their sizes go).
-                        let as_j = Sight {
-                            area: sj.area * ratio * ratio,
-                            ..sj
-                        };
-                        let as_i = Sight {
-                            area: si.area / (ratio * ratio),
-                            ..si
-                        };
-                        send(problem, &mut candidate, i, sj.on_receiver, as_j, sj.area);
-                        send(problem, &mut candidate, j, si.on_receiver, as_i, si.area);
-                        let e = search.evaluate(&candidate, ws);
-                        let mut launch = candidate.clone();
-                        let e = search.polish(&mut launch, e, &[i, j], ws);
-                        offer(&launch, &[i, j], &mut search, ws);
-                        exchanges.push(Exchange {
-                            launch,
-                            bodies: [i, j],
-                            free: search.free(&e),
-                        });
-                    }
+                // ... or each takes the other's pose and place (`exchange_poses`),
+                // polished and kept for the caller too.
+                if exchanges_wanted && exchangeable(scene, i, j) {
+                    candidate.copy_from_slice(params);
+                    exchange_poses(
+                        problem,
+                        &mut candidate,
+                        (i, si),
+                        (j, sj),
+                        &turned,
+                        &mut flight,
+                    );
+                    let e = search.evaluate(&candidate, ws);
+                    let mut launch = candidate.clone();
+                    let e = search.polish(&mut launch, e, &[i, j], ws);
+                    offer(&launch, &[i, j], &mut search, ws);
+                    exchanges.push(Exchange {
+                        launch,
+                        bodies: [i, j],
+                        free: search.free(&e),
+                    });
                 }
             }
         }
@@ -828,7 +809,44 @@ const MAX_EXCHANGE_PAIRS: usize = 30;
 /// two boxes; a sphere's pose shows nothing) and of different shapes.
 fn exchangeable(scene: &crate::scene::Scene, i: usize, j: usize) -> bool {
     let (a, b) = (&scene.occluders[i].shape, &scene.occluders[j].shape);
-    canonical(a).is_some() && canonical(b).is_some() && kind_of(a) == kind_of(b) && a != b
+    canonical(a).is_some() && std::mem::discriminant(a) == std::mem::discriminant(b) && a != b
+}
+
+/// Set the launches of bodies `i` and `j` (now seen as `si`, `sj`, turned to `turned` at
+/// `t`) in `params` so that each takes the other's orientation at `t` (the spin that
+/// reaches it, by [`spin_reaching`]; frames matched by [`canonical`]) and the other's
+/// line of sight, at the depth where its shadow has the other's size (as their bounding
+/// radii go): two bodies of one family in the same kind of pose (a king and a bishop
+/// lying down) often end each drawing the other's shadow at the other's size, which no
+/// swap that keeps the poses reproduces.
+fn exchange_poses(
+    problem: &Problem,
+    params: &mut [f64],
+    (i, si): (usize, Sight),
+    (j, sj): (usize, Sight),
+    turned: &[DQuat],
+    flight: &mut FreeFlight,
+) {
+    let scene = &problem.scene;
+    let frame = |k: usize| canonical(&scene.occluders[k].shape).unwrap_or(DQuat::IDENTITY);
+    let (ci, cj) = (frame(i), frame(j));
+    let want_i = turned[j] * cj * ci.conjugate();
+    let want_j = turned[i] * ci * cj.conjugate();
+    for (b, want) in [(i, want_i), (j, want_j)] {
+        let rotation = (want * turned[b].conjugate()).to_axis_angle();
+        turn_spin(problem, params, b, turned[b], rotation, true, flight);
+    }
+    let ratio = scene.occluders[i].bounding_radius / scene.occluders[j].bounding_radius;
+    let as_j = Sight {
+        area: sj.area * ratio * ratio,
+        ..sj
+    };
+    let as_i = Sight {
+        area: si.area / (ratio * ratio),
+        ..si
+    };
+    send(problem, params, i, sj.on_receiver, as_j, sj.area);
+    send(problem, params, j, si.on_receiver, as_i, si.area);
 }
 
 /// The rotation from a body's canonical frame to its own (body) frame, for a swap of
@@ -849,15 +867,6 @@ fn canonical(shape: &Shape) -> Option<DQuat> {
             // A right-handed frame: a box is symmetric under the sign of its third axis.
             Some(DQuat::from_mat3(&DMat3::from_cols(x, y, x.cross(y))))
         }
-    }
-}
-
-/// The kind of a shape, for [`canonical`] frames that mean the same across bodies.
-fn kind_of(shape: &Shape) -> u8 {
-    match shape {
-        Shape::Sphere { .. } => 0,
-        Shape::Cuboid { .. } => 1,
-        Shape::Mesh(_) => 2,
     }
 }
 

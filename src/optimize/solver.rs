@@ -345,6 +345,7 @@ pub fn solve(
                     EXCHANGE_SHARE * drawn as f64,
                     rank_value(&best_eval, scene.contacts),
                     stage_seed(seed, k),
+                    &mut ws,
                     &mut |e: &Evaluation| records.push(sample_record(k, iteration, stage, e)),
                 );
                 samples += better.1;
@@ -575,6 +576,7 @@ fn exchange(
     budget: f64,
     kept: f64,
     seed: u64,
+    ws: &mut Workspace,
     record: &mut dyn FnMut(&Evaluation),
 ) -> (Option<Vec<f64>>, usize) {
     let mut best: Option<(f64, Vec<f64>)> = None;
@@ -600,7 +602,7 @@ fn exchange(
             let seed = stage_seed(seed, 4 * t + g);
             let partner = x.bodies[1 - g % 2];
             let ignore = (g < 2).then_some(partner);
-            let (l, r, used) = local_run(problem, pool, &run, &launch, ignore, seed, record);
+            let (l, r, used) = local_run(problem, pool, &run, &launch, ignore, seed, ws, record);
             (launch, rank) = (l, r);
             samples += used;
             // A first round that draws no better picture than the launch kept, even with
@@ -619,6 +621,7 @@ fn exchange(
 /// One CMA-ES run of `run` (its bodies, step, population, iteration cap and stagnation)
 /// from `from`, the other bodies held: the best launch (`from` itself when no sample
 /// ranks better), its rank, and the samples drawn.
+#[allow(clippy::too_many_arguments)]
 fn local_run(
     problem: &Problem,
     pool: &Pool,
@@ -626,6 +629,7 @@ fn local_run(
     from: &[f64],
     ignore: Option<usize>,
     seed: u64,
+    ws: &mut Workspace,
     record: &mut dyn FnMut(&Evaluation),
 ) -> (Vec<f64>, f64, usize) {
     let contacts = problem.scene.contacts;
@@ -635,9 +639,8 @@ fn local_run(
         flags[j] = true;
         held.ignore_contacts_with(&flags);
     }
-    let mut ws = problem.workspace();
-    let start = problem.evaluate_held(&held, from, &run.weights, &mut ws);
-    let mut best = (rank_value(&start, contacts), None);
+    let start = problem.evaluate_held(&held, from, &run.weights, ws);
+    let mut best = rank_value(&start, contacts);
     let n = problem.stage_variable_count(&run.vary);
     let mut x0 = vec![0.0; n];
     problem.stage_start(from, &run.vary, &mut x0);
@@ -653,6 +656,8 @@ fn local_run(
     let mut evals = vec![Evaluation::diverged(); pop];
     let mut fitness = vec![0.0; pop];
     let mut candidates = vec![0.0; pop * n];
+    // The best sample's values, once one ranks better than `from`.
+    let mut best_x: Option<Vec<f64>> = None;
     let mut samples = 1;
     loop {
         candidates.copy_from_slice(cma.ask());
@@ -660,8 +665,10 @@ fn local_run(
         for (j, e) in evals.iter().enumerate() {
             fitness[j] = rank_value(e, contacts);
             record(e);
-            if fitness[j] < best.0 {
-                best = (fitness[j], Some(candidates[j * n..(j + 1) * n].to_vec()));
+            if fitness[j] < best {
+                best = fitness[j];
+                let x = best_x.get_or_insert_with(|| vec![0.0; n]);
+                x.copy_from_slice(&candidates[j * n..(j + 1) * n]);
             }
         }
         samples += pop;
@@ -671,10 +678,10 @@ fn local_run(
         }
     }
     let mut launch = from.to_vec();
-    if let Some(xs) = best.1 {
+    if let Some(xs) = best_x {
         problem.expand(from, &run.vary, &xs, &mut launch);
     }
-    (launch, best.0, samples)
+    (launch, best, samples)
 }
 
 /// The launch values a resumed solve starts from: the saved launch, and with free
