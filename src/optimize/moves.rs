@@ -23,16 +23,21 @@
 //!   connected to them (a body left too small or off-centre on its blob, which CMA-ES
 //!   steps toward slowly when the right size is far: chess pieces that must fly five
 //!   times closer to the light), the same way;
-//! - **turn** a body that is not a sphere a quarter or half turn about a world axis;
+//! - **turn** a body that is not a sphere a quarter or half turn about a world axis,
+//!   and a mesh whose three principal moments differ (a knight) about its own principal
+//!   axes too, about its centre of mass and moved so that its shadow keeps its centroid
+//!   (a half turn about its long axis mirrors a lying knight's profile, the mistake the
+//!   other moves leave: the knight's head on the wrong side);
 //! - **align** it: turn it about its line of sight so that its shadow's long axis lies
 //!   along its part's (both elongated, from their second moments);
 //! - **lay** it: turn its own long axis (of least inertia) across the line of sight along
 //!   its part's long axis, either way round (a piece seen end-on casts a round shadow
 //!   with no axis to align).
 //!
-//! Align and lay ask for an orientation at `t`; the launch spin that reaches it is solved
-//! by Newton's method on the free flight ([`spin_reaching`]), since adding `angle / t`
-//! to the spin turns a tumbling block somewhere else.
+//! Align, lay, the turns about a body's own axes and the exchanges ask for an orientation
+//! at `t`; the launch spin that reaches it is solved by Newton's method on the free flight
+//! ([`spin_reaching`]), since adding `angle / t` to the spin turns a tumbling block
+//! somewhere else.
 //!
 //! A move guesses a depth from the size of a shadow that is often wrong itself (a body
 //! left too low behind a contact), so the few moves of a pass that make the best
@@ -44,9 +49,9 @@
 //! velocity that puts it at a point is exact. Every candidate is evaluated like any
 //! sample and ranked by the solver's rank (contacts first under the constraint mode); the
 //! best one is taken when it ranks better than the current best, and the search repeats
-//! from it. A pass costs at most `n (n - 1) + 2 n + 15 m` samples for `n` launched
-//! bodies of which `m` are not spheres, and at most [`POLISHED`] times 6 per moved body
-//! for the polish.
+//! from it. A pass costs at most `n (n - 1) + 2 n + 15 m + 18 k` samples for `n`
+//! launched bodies of which `m` are not spheres and `k` are meshes with three distinct
+//! principal moments, and at most [`POLISHED`] times 6 per moved body for the polish.
 
 use glam::{DMat3, DQuat, DVec2, DVec3};
 
@@ -55,7 +60,7 @@ use crate::evaluate::{Evaluation, Held, Problem, Workspace};
 use crate::geometry::shape::Shape;
 use crate::scene::Launch;
 use crate::shadow::mask::{Mask, Moments};
-use crate::sim::flight::{FreeFlight, LaunchState};
+use crate::sim::flight::{FlightConfig, FreeFlight, LaunchState};
 
 /// Fraction of the light-to-receiver distance (along a line of sight) that a moved body's
 /// centre may take, at least: a body closer to the light than this casts a shadow over
@@ -90,6 +95,8 @@ struct Sight {
     depth: f64,
     /// The body's own shadow area (pixels), alone, at its pose at `t`.
     area: f64,
+    /// Its own shadow's centroid (canvas pixels); `None` when it misses the canvas.
+    centroid: Option<DVec2>,
     /// The body's part of the target: the target pixels that are bare or that it
     /// covers, connected to those it covers; its area (pixels) and centroid (canvas
     /// pixels). `None` when its shadow is on no target pixel, when another body's
@@ -401,6 +408,26 @@ pub fn improve(
                 continue;
             }
             let now = turned[i];
+            // An asymmetric mesh (a knight, most meshes a user brings) also turns about
+            // its own principal axes: a half turn about its long axis mirrors a lying
+            // knight's profile, which a turn about a world axis does only by also moving
+            // its long axis off its part. Its spin is not about one axis, so the turn is
+            // solved on the flight. Its centre of mass is rarely the middle of its shadow,
+            // so each turn is offered about it, and moved so that the shadow keeps its
+            // centroid (`recentre`): the first undoes a wrong turn, the second mends a
+            // wrong profile on its place.
+            if let (Shape::Mesh(_), Some(si)) = (&scene.occluders[i].shape, sights[i]) {
+                for axis in own_axes(&scene.occluders[i].mass).into_iter().flatten() {
+                    for angle in TURNS {
+                        candidate.copy_from_slice(params);
+                        let rotation = (now * axis, angle);
+                        turn_spin(problem, &mut candidate, i, now, rotation, true, &mut flight);
+                        offer(&candidate, &[i], &mut search, ws);
+                        recentre(problem, &mut candidate, i, si, &mut flight, ws);
+                        offer(&candidate, &[i], &mut search, ws);
+                    }
+                }
+            }
             let mut turn =
                 |axis: DVec3, angle: f64, exact: bool, search: &mut Search, ws: &mut Workspace| {
                     candidate.copy_from_slice(params);
@@ -538,6 +565,7 @@ fn sights(
                     on_receiver: light + (com - light) / depth,
                     depth,
                     area,
+                    centroid: None,
                     part: None,
                     axes: None,
                     part_axis: None,
@@ -567,6 +595,7 @@ fn sights(
             on_receiver: light + (com - light) / depth,
             depth,
             area,
+            centroid: own.centroid(),
             part: m
                 .centroid()
                 .filter(|_| !shared && same_shape)
@@ -708,15 +737,30 @@ fn turn_spin(
     launch.set(params, i);
 }
 
-/// Newton iterations of [`spin_reaching`], at most.
+/// Newton iterations of [`spin_reaching`] on the coarse flight, at most.
 const NEWTON_STEPS: usize = 12;
 
+/// Iterations of [`spin_reaching`] on the exact flight, at most, after Newton's method
+/// on the coarse one.
+const CHORD_STEPS: usize = 6;
+
+/// Rotation per RK4 step (rad, at the fastest the body's spin may get) of the coarse
+/// flight on which [`spin_reaching`] runs Newton's method: about 1e-4 of the turn's error
+/// at `t`, where the exact flight's steps of 0.02 rad cost five times as much.
+const COARSE_ANGLE: f64 = 0.1;
+
 /// The launch spin that turns body `i` to the orientation `want` at `t` in free flight,
-/// by Newton's method from `guess` on the rotation between the two (a finite-difference
-/// Jacobian, halved steps where a full one does not get closer); `None` when it does not
-/// converge to 1e-6 rad. Adding `angle / t` about an axis to the spin is exact only for
-/// a spin about a principal axis; a tumbling block needs this to turn where a move asks.
-fn spin_reaching(
+/// from `guess`; `None` when it does not converge to 1e-6 rad. Adding `angle / t` about
+/// an axis to the spin is exact only for a spin about a principal axis; a tumbling block
+/// needs this to turn where a move asks.
+///
+/// Newton's method (a finite-difference Jacobian, halved steps where a full one does not
+/// get closer) runs on a coarse flight: RK4 on a fixed number of steps set by the guess
+/// ([`COARSE_ANGLE`]), so that the miss is smooth in the spin (the exact flight's step
+/// count follows the spin, and a finite difference across a change of it is noise).
+/// Chord steps with the last Jacobian then bring the exact flight's miss under 1e-6 rad.
+/// For a body with two equal moments both flights are the exact closed form.
+pub fn spin_reaching(
     problem: &Problem,
     i: usize,
     want: DQuat,
@@ -726,42 +770,59 @@ fn spin_reaching(
     let scene = &problem.scene;
     let o = &scene.occluders[i];
     let t = scene.t;
-    let mut miss = |w: DVec3| -> DVec3 {
+    let limit = crate::evaluate::MAX_TURN / t;
+    if !guess.is_finite() || guess.length() > limit {
+        return None;
+    }
+    let k = o.mass.principal_inertia;
+    // The spin's greatest speed in flight is at most |w| I_max / I_min.
+    let turn = guess.length() * k.max_element() / k.min_element() * t;
+    let steps = (turn / COARSE_ANGLE).ceil().max(1.0);
+    let coarse = FlightConfig {
+        rk4_max_step: t / steps,
+        rk4_max_angle: f64::INFINITY,
+    };
+    let mut miss = |w: DVec3, cfg: &FlightConfig| -> DVec3 {
         let launch = LaunchState {
             origin: o.position,
             orientation: o.orientation,
             velocity: DVec3::ZERO,
             angular_velocity: w,
         };
-        flight.reset(&o.mass, launch, scene.gravity, t, &problem.flight);
+        flight.reset(&o.mass, launch, scene.gravity, t, cfg);
         let d = want.conjugate() * flight.orientation(t);
         if d.w < 0.0 { -d } else { d }.to_scaled_axis()
     };
-    let limit = crate::evaluate::MAX_TURN / t;
     let mut w = guess;
-    let mut r = miss(w);
+    let mut r = miss(w, &coarse);
+    let mut jacobian = None;
     for _ in 0..NEWTON_STEPS {
         if !r.is_finite() || w.length() > limit {
             return None;
         }
-        if r.length() < 1e-6 {
-            return Some(w);
+        if r.length() < 1e-6 && jacobian.is_some() {
+            break;
         }
         let h = 1e-6 * (1.0 + w.length());
         let j = DMat3::from_cols(
-            (miss(w + DVec3::X * h) - r) / h,
-            (miss(w + DVec3::Y * h) - r) / h,
-            (miss(w + DVec3::Z * h) - r) / h,
+            (miss(w + DVec3::X * h, &coarse) - r) / h,
+            (miss(w + DVec3::Y * h, &coarse) - r) / h,
+            (miss(w + DVec3::Z * h, &coarse) - r) / h,
         );
         let det = j.determinant();
         if det.is_nan() || det.abs() <= 1e-12 {
             return None;
         }
-        let step = -(j.inverse() * r);
+        let inverse = j.inverse();
+        jacobian = Some(inverse);
+        if r.length() < 1e-6 {
+            break;
+        }
+        let step = -(inverse * r);
         let mut lambda = 1.0;
         loop {
             let next = w + step * lambda;
-            let rn = miss(next);
+            let rn = miss(next, &coarse);
             if rn.length() < r.length() {
                 (w, r) = (next, rn);
                 break;
@@ -772,7 +833,18 @@ fn spin_reaching(
             }
         }
     }
-    (r.length() < 1e-6).then_some(w)
+    let inverse = jacobian?;
+    for _ in 0..=CHORD_STEPS {
+        let r = miss(w, &problem.flight);
+        if !r.is_finite() || w.length() > limit {
+            return None;
+        }
+        if r.length() < 1e-6 {
+            return Some(w);
+        }
+        w -= inverse * r;
+    }
+    None
 }
 
 /// A body whose long axis is already within this cosine of its part's direction is not
@@ -870,6 +942,60 @@ fn canonical(shape: &Shape) -> Option<DQuat> {
     }
 }
 
+/// Principal moments closer than this share of the largest count as equal for
+/// [`own_axes`]: a body with two such moments is close to a solid of revolution (a king,
+/// whose cross makes its two moments across its axis differ by 2e-4 of them; a knight's
+/// differ by 8 %).
+const REVOLUTION: f64 = 0.01;
+
+/// The body-frame principal axes of a body whose three principal moments differ (by
+/// more than [`REVOLUTION`]), as a knight's do; `None` for one close to a solid of
+/// revolution (a lathed chess piece: a turn about its axis shows the same shadow, and a
+/// half turn across it is close to the half turns about world axes that the moves
+/// already try).
+fn own_axes(mass: &crate::geometry::shape::MassProperties) -> Option<[DVec3; 3]> {
+    let k = mass.principal_inertia;
+    let tol = REVOLUTION * k.max_element();
+    let distinct = (k.x - k.y).abs() > tol && (k.y - k.z).abs() > tol && (k.z - k.x).abs() > tol;
+    distinct.then(|| [DVec3::X, DVec3::Y, DVec3::Z].map(|e| mass.principal_frame * e))
+}
+
+/// Move body `i` (seen as `own` before a turn that `params` now holds) at the same depth
+/// so that its own shadow's centroid is back where it was: a turn keeps the centre of
+/// mass, which an asymmetric body's shadow does not surround evenly. The shadow is drawn
+/// alone at the turned pose, in `ws`.
+fn recentre(
+    problem: &Problem,
+    params: &mut [f64],
+    i: usize,
+    own: Sight,
+    flight: &mut FreeFlight,
+    ws: &mut Workspace,
+) {
+    let scene = &problem.scene;
+    let o = &scene.occluders[i];
+    let Some(before) = own.centroid else { return };
+    flight.reset(
+        &o.mass,
+        LaunchState::of(o, Launch::get(params, i)),
+        scene.gravity,
+        scene.t,
+        &problem.flight,
+    );
+    ws.poses[i] = flight.pose(scene.t);
+    let mut only = vec![false; scene.occluders.len()];
+    only[i] = true;
+    problem.shadow_only(&only, ws);
+    let Some(after) = ws.mask.moments().centroid() else {
+        return;
+    };
+    let c = &problem.canvas;
+    let shift = c.pixel_to_world(before.x, before.y) - c.pixel_to_world(after.x, after.y);
+    // A shift at depth `d` (0 at the light, 1 on the receiver) moves the shadow `1 / d`
+    // times as far.
+    aim(problem, params, i, own.com + shift * own.depth);
+}
+
 /// The body-frame direction of a body's long axis: the principal axis of least inertia.
 fn long_body_axis(mass: &crate::geometry::shape::MassProperties) -> DVec3 {
     let k = mass.principal_inertia;
@@ -920,6 +1046,23 @@ mod tests {
             dx * dx + dy * dy < 900.0
         });
         assert_eq!(long_axis(&disc.moments()), None);
+    }
+
+    #[test]
+    fn only_a_body_far_from_a_solid_of_revolution_turns_about_its_own_axes() {
+        let mass = |k: DVec3| crate::geometry::shape::MassProperties {
+            mass: 0.05,
+            local_com: DVec3::ZERO,
+            principal_inertia: k,
+            principal_frame: DQuat::from_rotation_z(0.3),
+        };
+        // The chess set's knight and king (kg m^2): the king's cross parts its two moments
+        // across its axis by 2e-4 of them, the knight's head by 8 %.
+        let knight = own_axes(&mass(DVec3::new(1.739e-6, 6.213e-6, 6.736e-6)));
+        let axes = knight.expect("a knight turns about its own axes");
+        assert!((axes[0] - DQuat::from_rotation_z(0.3) * DVec3::X).length() < 1e-12);
+        assert!(own_axes(&mass(DVec3::new(1.776e-6, 1.9044e-5, 1.9047e-5))).is_none());
+        assert!(own_axes(&mass(DVec3::splat(2e-6))).is_none());
     }
 
     #[test]

@@ -451,6 +451,57 @@ fn exchanges_give_two_blocks_each_others_pose_and_place() {
 }
 
 #[test]
+fn moves_mirror_a_knight_that_shows_its_profile_the_wrong_way_round() {
+    // A knight and a pawn, planted: IoU 1.
+    let pieces = root().join("scenes/thinker/pieces");
+    let objects = format!(
+        "mesh:{}/knight.obj/900,mesh:{}/pawn.obj/900",
+        pieces.display(),
+        pieces.display()
+    );
+    let (p, planted) = planted("moves-mirror", &objects, "0.96");
+    let w = p.scene.stages.last().unwrap().weights;
+    let mut ws = p.workspace();
+    assert!(p.evaluate(&planted, &w, &mut ws).iou > 0.9999);
+    // The knight turned half a turn about its own long axis at `t` (a tumbling knight: its
+    // spin is solved on the flight): its profile mirrored, about its centre of mass.
+    let now = ws.poses[0].1;
+    let mass = &p.scene.occluders[0].mass;
+    let k = mass.principal_inertia;
+    let least = if k.x <= k.y && k.x <= k.z {
+        glam::DVec3::X
+    } else if k.y <= k.z {
+        glam::DVec3::Y
+    } else {
+        glam::DVec3::Z
+    };
+    let axis = now * (mass.principal_frame * least);
+    let want = glam::DQuat::from_axis_angle(axis, std::f64::consts::PI) * now;
+    let guess = glam::DVec3::from_slice(&planted[3..6]);
+    let mut flight = bsa::sim::flight::FreeFlight::default();
+    let spin = bsa::optimize::moves::spin_reaching(&p, 0, want, guess, &mut flight)
+        .expect("a spin that mirrors the knight");
+    let mut params = planted.clone();
+    params[3..6].copy_from_slice(&spin.to_array());
+    p.evaluate(&params, &w, &mut ws);
+    assert!(
+        ws.poses[0].1.angle_between(want) < 1e-5,
+        "the knight misses its turn by {} rad",
+        ws.poses[0].1.angle_between(want)
+    );
+    // The moves turn it back (and put its shadow back on its part).
+    let (before, best, report) = run_moves(&p, &mut params, &contact_free_first);
+    assert!(before < 0.9, "IoU {before}");
+    assert!(report.accepted >= 1, "{report:?}");
+    assert!(
+        best.iou > 0.97 && best.iou > before + 0.05,
+        "IoU {before} -> {}",
+        best.iou
+    );
+    assert_eq!(best.outcome.n_contacts, 0);
+}
+
+#[test]
 fn moves_send_a_hidden_body_back_to_the_bare_part_of_the_target() {
     let (p, planted) = planted_pair("moves-hidden");
     let mut ws = p.workspace();
