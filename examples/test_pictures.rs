@@ -305,6 +305,46 @@ fn disc_arc(x: f64, y: f64) -> bool {
     })
 }
 
+fn disc_zigzag(x: f64, y: f64) -> bool {
+    // Six discs of radius 30 on a zigzag across the frame, alternately 70 pixels above
+    // and below its middle line.
+    (0..6).any(|k| {
+        let cx = -225.0 + 90.0 * k as f64;
+        let cy = if k % 2 == 0 { -70.0 } else { 70.0 };
+        (x - cx).hypot(y - cy) <= 30.0
+    })
+}
+
+/// Set 13: defined in a later session after its last change to the solver (a knight's
+/// turns about its own axes), its objects stated with it as an artist would fill each
+/// picture, and run once.
+fn pictures_13() -> Vec<(&'static str, Shape, String, &'static str)> {
+    let chess_stage = "--width 0.96 --light-height 3";
+    let glyph = |name, c, objects: String| (name, Shape::Glyph(c, 6), objects, "");
+    let chess = |name, c| (name, Shape::Glyph(c, 0), "chess".to_string(), chess_stage);
+    vec![
+        glyph("de", '\u{0414}', format!("{DOUBLE}*3,{UNIT}*2")),
+        glyph("el", '\u{041B}', format!("{DOUBLE}*2,{UNIT}")),
+        glyph("pe", '\u{041F}', format!("{DOUBLE}*3")),
+        glyph("tse", '\u{0426}', format!("{DOUBLE}*3,{UNIT}")),
+        glyph("che", '\u{0427}', format!("{DOUBLE},{UNIT}*2")),
+        glyph("e-reversed", '\u{042D}', format!("{UNIT}*6")),
+        glyph("ya", '\u{042F}', format!("{DOUBLE},{UNIT}*5")),
+        glyph("be", '\u{0411}', format!("{DOUBLE},{UNIT}*5")),
+        glyph("small-lambda", '\u{03BB}', format!("{DOUBLE},{UNIT}")),
+        glyph("small-mu", '\u{03BC}', format!("{DOUBLE}*2,{UNIT}*2")),
+        glyph("small-pi", '\u{03C0}', format!("{DOUBLE},{UNIT}*2")),
+        (
+            "disc-zigzag",
+            Shape::Drawn(disc_zigzag),
+            "sphere:0.07*6".to_string(),
+            "",
+        ),
+        chess("fleur-de-lis", '\u{269C}'),
+        chess("floral-heart", '\u{2766}'),
+    ]
+}
+
 /// Set 12: defined in a later session after its last change to the solver (a budget
 /// for the exchanges), its objects stated with it as an artist would fill each picture,
 /// and run once.
@@ -919,7 +959,8 @@ fn main() -> Result<(), Box<dyn Error>> {
         "10" => (pictures_10(), "tools/test-pictures-10"),
         "11" => (pictures_11(), "tools/test-pictures-11"),
         "12" => (pictures_12(), "tools/test-pictures-12"),
-        other => return Err(format!("SET must be 1 to 12, got {other:?}").into()),
+        "13" => (pictures_13(), "tools/test-pictures-13"),
+        other => return Err(format!("SET must be 1 to 13, got {other:?}").into()),
     };
     let dir = args
         .get(1)
