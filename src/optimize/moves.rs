@@ -800,6 +800,8 @@ pub fn spin_reaching(
         if !r.is_finite() || w.length() > limit {
             return None;
         }
+        // The chord steps need a Jacobian, so a guess that already meets the coarse
+        // flight still gets one below.
         if r.length() < 1e-6 && jacobian.is_some() {
             break;
         }
@@ -859,7 +861,7 @@ fn lays(problem: &Problem, i: usize, now: DQuat, com: DVec3, angle: f64) -> Vec<
     let along = (com - cam.light).normalize();
     let d = cam.u * angle.cos() - cam.v * angle.sin();
     let d = (d - along * d.dot(along)).normalize_or_zero();
-    let long = now * long_body_axis(&problem.scene.occluders[i].mass);
+    let long = now * problem.scene.occluders[i].mass.long_axis();
     if d == DVec3::ZERO || long.dot(d).abs() >= LAID {
         return Vec::new();
     }
@@ -996,19 +998,6 @@ fn recentre(
     aim(problem, params, i, own.com + shift * own.depth);
 }
 
-/// The body-frame direction of a body's long axis: the principal axis of least inertia.
-fn long_body_axis(mass: &crate::geometry::shape::MassProperties) -> DVec3 {
-    let k = mass.principal_inertia;
-    let e = if k.x <= k.y && k.x <= k.z {
-        DVec3::X
-    } else if k.y <= k.z {
-        DVec3::Y
-    } else {
-        DVec3::Z
-    };
-    mass.principal_frame * e
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1104,16 +1093,14 @@ mod tests {
         let along = (com - cam.light).normalize();
         for angle in [0.0f64, 0.7, -1.2] {
             // Stood on its end, along the line of sight: its shadow has no long axis.
-            let now = DQuat::from_rotation_arc(long_body_axis(mass), along);
+            let now = DQuat::from_rotation_arc(mass.long_axis(), along);
             let turns = lays(&p, 0, now, com, angle);
             assert_eq!(turns.len(), 2);
             let d = cam.u * angle.cos() - cam.v * angle.sin();
             let d = (d - along * d.dot(along)).normalize();
             let ends: Vec<f64> = turns
                 .iter()
-                .map(|&(axis, a)| {
-                    (DQuat::from_axis_angle(axis, a) * now * long_body_axis(mass)).dot(d)
-                })
+                .map(|&(axis, a)| (DQuat::from_axis_angle(axis, a) * now * mass.long_axis()).dot(d))
                 .collect();
             assert!(
                 (ends[0] - 1.0).abs() < 1e-9 && (ends[1] + 1.0).abs() < 1e-9,

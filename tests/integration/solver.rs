@@ -466,16 +466,7 @@ fn moves_mirror_a_knight_that_shows_its_profile_the_wrong_way_round() {
     // The knight turned half a turn about its own long axis at `t` (a tumbling knight: its
     // spin is solved on the flight): its profile mirrored, about its centre of mass.
     let now = ws.poses[0].1;
-    let mass = &p.scene.occluders[0].mass;
-    let k = mass.principal_inertia;
-    let least = if k.x <= k.y && k.x <= k.z {
-        glam::DVec3::X
-    } else if k.y <= k.z {
-        glam::DVec3::Y
-    } else {
-        glam::DVec3::Z
-    };
-    let axis = now * (mass.principal_frame * least);
+    let axis = now * p.scene.occluders[0].mass.long_axis();
     let want = glam::DQuat::from_axis_angle(axis, std::f64::consts::PI) * now;
     let guess = glam::DVec3::from_slice(&planted[3..6]);
     let mut flight = bsa::sim::flight::FreeFlight::default();

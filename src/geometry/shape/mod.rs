@@ -515,6 +515,20 @@ impl MassProperties {
         let p = DMat3::from_quat(self.principal_frame);
         p * DMat3::from_diagonal(self.principal_inertia) * p.transpose()
     }
+
+    /// The body-frame direction of the body's long axis: the principal axis of least
+    /// inertia (the first of equal least moments).
+    pub fn long_axis(&self) -> DVec3 {
+        let k = self.principal_inertia;
+        let e = if k.x <= k.y && k.x <= k.z {
+            DVec3::X
+        } else if k.y <= k.z {
+            DVec3::Y
+        } else {
+            DVec3::Z
+        };
+        self.principal_frame * e
+    }
 }
 
 impl Shape {
