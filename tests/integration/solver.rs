@@ -493,6 +493,43 @@ fn moves_mirror_a_knight_that_shows_its_profile_the_wrong_way_round() {
 }
 
 #[test]
+fn moves_fit_a_block_tilted_off_its_part_on_its_pose_at_t() {
+    // Two blocks, planted: IoU 1.
+    let (p, planted) = planted(
+        "moves-fit-pose",
+        "box:0.14x0.07x0.035,box:0.28x0.07x0.035",
+        "1.6",
+    );
+    let w = p.scene.stages.last().unwrap().weights;
+    let mut ws = p.workspace();
+    assert!(p.evaluate(&planted, &w, &mut ws).iou > 0.9999);
+    // The long block's launch spin changed by 0.08 rad over the flight about an axis
+    // across its line of sight at `t`: the block, tumbling, ends tilted, its outline near
+    // its part's with its corners moved, which no turn of a quarter or a half mends.
+    let (origin, now) = ws.poses[1];
+    let com = origin + now * p.scene.occluders[1].mass.local_com;
+    let sight = (com - p.scene.camera.light).normalize();
+    let across = sight.cross(now * glam::DVec3::X).normalize();
+    let mut params = planted.clone();
+    for (k, x) in (across * (0.08 / p.scene.t))
+        .to_array()
+        .into_iter()
+        .enumerate()
+    {
+        params[9 + k] += x;
+    }
+    let (before, best, report) = run_moves(&p, &mut params, &contact_free_first);
+    assert!(before < 0.97, "IoU {before}");
+    assert!(report.accepted >= 1, "{report:?}");
+    assert!(
+        best.iou > 0.99 && best.iou > before + 0.02,
+        "IoU {before} -> {}",
+        best.iou
+    );
+    assert_eq!(best.outcome.n_contacts, 0);
+}
+
+#[test]
 fn moves_send_a_hidden_body_back_to_the_bare_part_of_the_target() {
     let (p, planted) = planted_pair("moves-hidden");
     let mut ws = p.workspace();
