@@ -36,7 +36,10 @@
 //! - **fit the poses** of the blocks: each block in turn, the others' shadows kept, is
 //!   searched on its pose at `t` itself (turns, shifts and depth, [`fit_pose`]) for
 //!   fewer wrong pixels, then launched there (its spin by [`spin_reaching`]): one
-//!   candidate that moves every block that gained. A tumbling block's launch spin
+//!   candidate that moves every block that gained. The blocks that the best few moves
+//!   of a pass moved are fitted so too, after their polish (a block turned onto another
+//!   face or sent to a new part rarely has its part's size, place and tilt at once). A
+//!   tumbling block's launch spin
 //!   reaches its pose through the whole flight, so a block tilted a little the wrong way
 //!   is a narrow valley for CMA-ES and a smooth one here.
 //!
@@ -58,8 +61,9 @@
 //! from it. A pass costs at most `n (n - 1) + 2 n + 15 m + 18 k + 1` samples for `n`
 //! launched bodies of which `m` are not spheres and `k` are meshes with three distinct
 //! principal moments, and at most [`POLISHED`] times 6 per moved body for the polish;
-//! the pose fit draws at most `1 + 12 POSE_LEVELS POSE_SWEEPS` (241) shadows of one
-//! block per block, which are not samples (no flight, no contact search).
+//! each fit of the polish costs 2 samples more; a pose fit draws at most
+//! `1 + 12 POSE_LEVELS POSE_SWEEPS` (241) shadows of one block, which are not samples
+//! (no flight, no contact search).
 
 use glam::{DMat3, DQuat, DVec2, DVec3};
 
@@ -484,38 +488,19 @@ pub fn improve(
                 }
             }
         }
-        // Every body that is not a sphere fitted to the picture on its pose at `t`, one
-        // after the other (`fit_pose`), and launched there.
+        // Every block fitted to the picture on its pose at `t`, one after the other
+        // (`fit_pose`), and launched there.
+        let vary: Vec<bool> = (0..scene.occluders.len())
+            .map(|k| movable.contains(&k))
+            .collect();
+        let is_block = |i: usize| fits_pose(&scene.occluders[i].shape);
         {
             candidate.copy_from_slice(params);
-            let mut fitted = Vec::new();
-            let vary: Vec<bool> = (0..scene.occluders.len())
-                .map(|k| movable.contains(&k))
-                .collect();
             ws.poses.copy_from_slice(&current_poses);
-            for &i in &movable {
-                if !fits_pose(&scene.occluders[i].shape) {
-                    continue;
-                }
-                let mut which = vary.clone();
-                which[i] = false;
-                problem.shadow_held_and(held, &which, ws);
-                let others = ws.mask.clone();
-                let kept = ws.poses[i];
-                let Some((com, q)) = fit_pose(problem, i, &others, ws) else {
-                    ws.poses[i] = kept;
-                    continue;
-                };
-                let spin = Launch::get(&candidate, i).angular_velocity;
-                match spin_reaching(problem, i, q, spin, &mut flight) {
-                    Some(w) => {
-                        let mut launch = Launch::get(&candidate, i);
-                        launch.angular_velocity = w;
-                        launch.set(&mut candidate, i);
-                        aim(problem, &mut candidate, i, com);
-                        fitted.push(i);
-                    }
-                    None => ws.poses[i] = kept,
+            let mut fitted = Vec::new();
+            for &i in movable.iter().filter(|&&i| is_block(i)) {
+                if fit_and_launch(problem, held, &vary, i, &mut candidate, ws, &mut flight) {
+                    fitted.push(i);
                 }
             }
             if !fitted.is_empty() {
@@ -530,6 +515,32 @@ pub fn improve(
             if polished < POLISHED && (options.polish_single || offer.bodies.len() > 1) {
                 offer.eval = search.polish(&mut offer.launch, offer.eval, &offer.bodies, ws);
                 polished += 1;
+                // The blocks it moved fitted on their new poses too: a block turned onto
+                // another face, or sent to a new part, rarely has its part's size, place
+                // and tilt at once.
+                if offer.bodies.iter().any(|&b| is_block(b)) {
+                    candidate.copy_from_slice(&offer.launch);
+                    search.evaluate(&candidate, ws);
+                    let mut moved = false;
+                    for &b in offer.bodies.iter().filter(|&&b| is_block(b)) {
+                        moved |= fit_and_launch(
+                            problem,
+                            held,
+                            &vary,
+                            b,
+                            &mut candidate,
+                            ws,
+                            &mut flight,
+                        );
+                    }
+                    if moved {
+                        let e = search.evaluate(&candidate, ws);
+                        if search.free(&e) < search.free(&offer.eval) {
+                            offer.eval = e;
+                            offer.launch.copy_from_slice(&candidate);
+                        }
+                    }
+                }
             }
             let r = rank(&offer.eval);
             if r < best_rank {
@@ -1100,6 +1111,44 @@ fn fit_pose(
     }
     ws.poses[i] = (com - q * local, q);
     (best < start).then_some((com, q))
+}
+
+/// [`fit_pose`] body `i` (whose pose at `t` `ws.poses` holds, as for every body in
+/// `vary`) on the picture of the held bodies and the other bodies of `vary`, and launch
+/// it there in `candidate`: its spin by [`spin_reaching`] and its velocity by [`aim`].
+/// `true` when it moved; otherwise `candidate` and its pose are unchanged.
+#[allow(clippy::too_many_arguments)]
+fn fit_and_launch(
+    problem: &Problem,
+    held: &Held,
+    vary: &[bool],
+    i: usize,
+    candidate: &mut [f64],
+    ws: &mut Workspace,
+    flight: &mut FreeFlight,
+) -> bool {
+    let mut which = vary.to_vec();
+    which[i] = false;
+    problem.shadow_held_and(held, &which, ws);
+    let others = ws.mask.clone();
+    let kept = ws.poses[i];
+    let Some((com, q)) = fit_pose(problem, i, &others, ws) else {
+        ws.poses[i] = kept;
+        return false;
+    };
+    let mut launch = Launch::get(candidate, i);
+    match spin_reaching(problem, i, q, launch.angular_velocity, flight) {
+        Some(w) => {
+            launch.angular_velocity = w;
+            launch.set(candidate, i);
+            aim(problem, candidate, i, com);
+            true
+        }
+        None => {
+            ws.poses[i] = kept;
+            false
+        }
+    }
 }
 
 /// Whether [`fit_pose`] is tried on a body of this shape: blocks only. A sphere has no
