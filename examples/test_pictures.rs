@@ -315,6 +315,53 @@ fn disc_zigzag(x: f64, y: f64) -> bool {
     })
 }
 
+fn disc_cross(x: f64, y: f64) -> bool {
+    // Five discs of radius 30 in a plus sign: one in the middle and one 100 pixels from it
+    // on each side, above and below.
+    [
+        (0.0, 0.0),
+        (-100.0, 0.0),
+        (100.0, 0.0),
+        (0.0, -100.0),
+        (0.0, 100.0),
+    ]
+    .iter()
+    .any(|&(cx, cy)| (x - cx).hypot(y - cy) <= 30.0)
+}
+
+/// Set 14: defined in a later session after its last change to the solver (blocks
+/// fitted on their poses at `t`), its objects stated with it as an artist would fill each
+/// picture (a double unit for each long straight stroke, units along curves and short
+/// strokes), and run once. The two pictures for the chess set are filled silhouettes
+/// (a black florette and a twelve-pointed black star), as the issue's "a silhouette or
+/// two" asks, chosen by that rule before any solve.
+fn pictures_14() -> Vec<(&'static str, Shape, String, &'static str)> {
+    let chess_stage = "--width 0.96 --light-height 3";
+    let glyph = |name, c, objects: String| (name, Shape::Glyph(c, 6), objects, "");
+    let chess = |name, c| (name, Shape::Glyph(c, 0), "chess".to_string(), chess_stage);
+    vec![
+        glyph("ge", '\u{0413}', format!("{DOUBLE}*2")),
+        glyph("i-cyrillic", '\u{0418}', format!("{DOUBLE}*3")),
+        glyph("u-cyrillic", '\u{0423}', format!("{DOUBLE}*2,{UNIT}")),
+        glyph("shcha", '\u{0429}', format!("{DOUBLE}*4,{UNIT}")),
+        glyph("soft-sign", '\u{042C}', format!("{DOUBLE},{UNIT}*5")),
+        glyph("yery", '\u{042B}', format!("{DOUBLE}*2,{UNIT}*5")),
+        glyph("ze", '\u{0417}', format!("{UNIT}*7")),
+        glyph("ef", '\u{0424}', format!("{DOUBLE},{UNIT}*8")),
+        glyph("small-eta", '\u{03B7}', format!("{DOUBLE},{UNIT}*4")),
+        glyph("small-tau", '\u{03C4}', format!("{DOUBLE},{UNIT}*2")),
+        glyph("small-omega", '\u{03C9}', format!("{UNIT}*8")),
+        (
+            "disc-cross",
+            Shape::Drawn(disc_cross),
+            "sphere:0.07*5".to_string(),
+            "",
+        ),
+        chess("florette", '\u{273F}'),
+        chess("star-twelve", '\u{2739}'),
+    ]
+}
+
 /// Set 13: defined in a later session after its last change to the solver (a knight's
 /// turns about its own axes), its objects stated with it as an artist would fill each
 /// picture, and run once.
@@ -960,7 +1007,8 @@ fn main() -> Result<(), Box<dyn Error>> {
         "11" => (pictures_11(), "tools/test-pictures-11"),
         "12" => (pictures_12(), "tools/test-pictures-12"),
         "13" => (pictures_13(), "tools/test-pictures-13"),
-        other => return Err(format!("SET must be 1 to 13, got {other:?}").into()),
+        "14" => (pictures_14(), "tools/test-pictures-14"),
+        other => return Err(format!("SET must be 1 to 14, got {other:?}").into()),
     };
     let dir = args
         .get(1)
