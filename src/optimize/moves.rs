@@ -1137,7 +1137,13 @@ fn fit_and_launch(
         return false;
     };
     let mut launch = Launch::get(candidate, i);
-    match spin_reaching(problem, i, q, launch.angular_velocity, flight) {
+    // The turn added to the spin as the first guess (exact for a spin about a principal
+    // axis): Newton's method on a tumbling body's flight can stray from a guess a whole
+    // turn away.
+    let d = q * kept.1.conjugate();
+    let turn = if d.w < 0.0 { -d } else { d }.to_scaled_axis();
+    let guess = launch.angular_velocity + turn / problem.scene.t;
+    match spin_reaching(problem, i, q, guess, flight) {
         Some(w) => {
             launch.angular_velocity = w;
             launch.set(candidate, i);
