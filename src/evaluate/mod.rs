@@ -687,12 +687,6 @@ impl Problem {
         self.shadow_with(Some(&held.mask), Some(which), ws)
     }
 
-    /// The shadow of the occluders in `which` at the poses in `ws.poses`, drawn over
-    /// `start`, into `ws.mask`.
-    pub fn shadow_over(&self, start: &Mask, which: &[bool], ws: &mut Workspace) {
-        self.shadow_with(Some(start), Some(which), ws)
-    }
-
     /// [`Problem::shadow`] of the occluders in `which` only, drawn over `start` (a held
     /// shadow; OR is order-free, so the mask is the same as drawing everything).
     fn shadow_with(&self, start: Option<&Mask>, which: Option<&[bool]>, ws: &mut Workspace) {

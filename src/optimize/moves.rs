@@ -1063,13 +1063,22 @@ fn fit_pose(
     let mut only = vec![false; scene.occluders.len()];
     only[i] = true;
     let target = &problem.target.mask;
-    let cost = |com: DVec3, q: DQuat, ws: &mut Workspace| -> u64 {
+    // The wrong pixels of the whole picture with the body's shadow `s` drawn over the
+    // others: those of the others alone, plus the pixels of `s` on neither the target
+    // nor another shadow, minus those of `s` on bare target. Counted on `s` alone, whose
+    // rows are few, rather than on the whole canvas.
+    let base = others.xor_count(target) as i64;
+    let mut dark = others.clone();
+    dark.or_assign(target);
+    let bare = target.and_not(others);
+    let cost = |com: DVec3, q: DQuat, ws: &mut Workspace| -> i64 {
         if floor.is_some_and(|z| com.z < z) {
-            return u64::MAX;
+            return i64::MAX;
         }
         ws.poses[i] = (com - q * local, q);
-        problem.shadow_over(others, &only, ws);
-        ws.mask.xor_count(target)
+        problem.shadow_only(&only, ws);
+        let s = &ws.mask;
+        base + s.count() as i64 - s.and_count(&dark) as i64 - s.and_count(&bare) as i64
     };
     let sight = (com0 - light).normalize();
     let e1 = sight.any_orthonormal_vector();

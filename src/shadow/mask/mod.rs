@@ -447,7 +447,29 @@ impl Mask {
     /// the popcounts of consecutive words can overlap in the pipeline.
     #[inline(always)]
     fn pair_count(&self, other: &Mask, op: impl Fn(u64, u64) -> u64 + Copy) -> u64 {
+        self.pair_count_in(other, self.union_words(other), op)
+    }
+
+    /// The words of the rows where both masks may hold set bits (an AND is zero
+    /// elsewhere).
+    fn common_words(&self, other: &Mask) -> Range<usize> {
         let r = self.union_words(other);
+        let (a, b) = (&self.rows, &other.rows);
+        let (start, end) = (a.start.max(b.start), a.end.min(b.end));
+        if start >= end {
+            return r.start..r.start;
+        }
+        start * self.words_per_row..end * self.words_per_row
+    }
+
+    /// [`Mask::pair_count`] over the word range `r`.
+    #[inline(always)]
+    fn pair_count_in(
+        &self,
+        other: &Mask,
+        r: Range<usize>,
+        op: impl Fn(u64, u64) -> u64 + Copy,
+    ) -> u64 {
         let a = &self.words[r.clone()];
         let b = &other.words[r];
         #[cfg(target_arch = "x86_64")]
@@ -473,7 +495,7 @@ impl Mask {
 
     /// Number of pixels set in both masks.
     pub fn and_count(&self, other: &Mask) -> u64 {
-        self.pair_count(other, |a, b| a & b)
+        self.pair_count_in(other, self.common_words(other), |a, b| a & b)
     }
 
     /// Number of pixels set in `self` but not in `other` (popcount of `self & !other`).
