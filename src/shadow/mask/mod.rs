@@ -453,11 +453,12 @@ impl Mask {
     /// The words of the rows where both masks may hold set bits (an AND is zero
     /// elsewhere).
     fn common_words(&self, other: &Mask) -> Range<usize> {
-        let r = self.union_words(other);
+        // The size check, as for every pair of masks.
+        self.union_words(other);
         let (a, b) = (&self.rows, &other.rows);
         let (start, end) = (a.start.max(b.start), a.end.min(b.end));
         if start >= end {
-            return r.start..r.start;
+            return 0..0;
         }
         start * self.words_per_row..end * self.words_per_row
     }
