@@ -15,6 +15,7 @@
 # target and the same objects (its own launch positions, hints, heights and trial solves),
 # then `bsa solve` solves it; the wall time is then that of both commands.
 # Problems and solves go to $ROOT/<class>-<seed>/ (ROOT defaults to /tmp/bsa-planted);
+# CLASSES="chess mix" runs only those classes;
 # BSA=PATH runs another binary (e.g. an older build, for a side-by-side comparison); prints one line per problem
 # and a table per class: IoU (min / median / max), solves with a contact before t,
 # samples and wall time (median).
@@ -54,7 +55,7 @@ else:
     print(",".join(s + b), 1.6, 6.0)
 PY
 }
-for class in spheres boxes boxes12 chess mix; do
+for class in ${CLASSES:-spheres boxes boxes12 chess mix}; do
     for ((k = 0; k < per; k++)); do
         seed=$((first + k))
         dir=$root/$class-$seed

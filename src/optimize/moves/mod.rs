@@ -1,19 +1,20 @@
 //! Assignment moves: the global jumps that CMA-ES does not make.
 //!
 //! A joint stage refines launches locally; it does not send a body across the picture.
-//! Two failures follow on problems that have a perfect answer: two bodies each cover the
-//! other's part (a large sphere lowered onto a small blob while the small sphere sits
-//! high on the large one), and a body hidden under another's shadow while a part of the
-//! target stays bare (the image energy does not change while it moves under the other
-//! shadow, so nothing draws it out). [`improve`] tries, from the best launch so far:
+//! Two failures follow on problems that have a perfect answer: two bodies each cover
+//! the other's part (a large sphere lowered onto a small blob while the small sphere
+//! sits high on the large one), and a body hidden under another's shadow while a part
+//! of the target stays bare (the image energy does not change while it moves under the
+//! other shadow, so nothing draws it out). [`improve`] tries, from the best launch so
+//! far:
 //! - **swap** bodies `i` and `j`: each is sent to the other's line of sight from the
 //!   light, at the depth where its own shadow has the other's area, so that the picture
 //!   is unchanged up to the two shapes; or each is sent to the other's place in space;
-//!   or, where both bodies' parts are known (see `fit`), each to the other's part at the
-//!   part's whole size; or, for two bodies of one kind and different shapes, each to the
-//!   other's pose at `t` and place (an **exchange**, [`MoveReport::exchanges`]: rarely
-//!   better as it stands, so the solver also refines the best few before it judges
-//!   them);
+//!   or, where both bodies' parts are known (see `fit`), each to the other's part at
+//!   the part's whole size; or, for two bodies of one kind and different shapes, each
+//!   to the other's pose at `t` and place (an **exchange**, [`MoveReport::exchanges`]:
+//!   rarely better as it stands, so the solver also refines the best few before it
+//!   judges them);
 //! - **fill** the largest bare part of the target with body `i`: sent to the line of
 //!   sight through the part's centroid, at the depth where its shadow has the part's
 //!   area, and, if it is not a sphere and the part is elongated, also laid along the
@@ -30,49 +31,68 @@
 //!   other moves leave: the knight's head on the wrong side);
 //! - **align** it: turn it about its line of sight so that its shadow's long axis lies
 //!   along its part's (both elongated, from their second moments);
-//! - **lay** it: turn its own long axis (of least inertia) across the line of sight along
-//!   its part's long axis, either way round (a piece seen end-on casts a round shadow
-//!   with no axis to align);
+//! - **lay** it: turn its own long axis (of least inertia) across the line of sight
+//!   along its part's long axis, either way round (a piece seen end-on casts a round
+//!   shadow with no axis to align);
 //! - **fit the poses** of the blocks: each block in turn, the others' shadows kept, is
-//!   searched on its pose at `t` itself (turns, shifts and depth, [`fit_pose`]) for
-//!   fewer wrong pixels, then launched there (its spin by [`spin_reaching`]): one
-//!   candidate that moves every block that gained. The blocks that a pass's best move
-//!   or its polished swaps and exchanges moved are fitted so too, after their polish (a
-//!   block turned onto another face or sent to a new part rarely has its part's size,
-//!   place and tilt at once). A tumbling block's launch spin reaches its pose through
-//!   the whole flight, so a block tilted a little the wrong way is a narrow valley for
-//!   CMA-ES and a smooth one here.
+//!   searched on its pose at `t` itself (turns, shifts and depth,
+//!   [`fit_pose`](pose::fit_pose)) for fewer wrong pixels, then launched there (its
+//!   spin by [`spin_reaching`]): one candidate that moves every block that gained. The
+//!   blocks that a pass's best move or its polished swaps and exchanges moved are
+//!   fitted so too, after their polish (a block turned onto another face or sent to a
+//!   new part rarely has its part's size, place and tilt at once). A tumbling block's
+//!   launch spin reaches its pose through the whole flight, so a block tilted a little
+//!   the wrong way is a narrow valley for CMA-ES and a smooth one here.
+//! - **seat** a mesh, in the first pass of a call ([`seat_pose`](pose::seat_pose)):
+//!   posed at `t` with its axis (of symmetry for a lathed piece, else its long axis, at
+//!   six rolls about it) in each of 64 directions, each placed on a place of the
+//!   picture (the centroid and area of a shadow), the best three refined by the compass
+//!   search of the pose fit, then launched there. Each mesh is seated on its own place,
+//!   and two meshes of one kind and different shapes each on the other's (every pair
+//!   scanned, the best [`SEAT_PAIRS`] refined): a piece on a wrong
+//!   face, or a king and a queen on each other's parts in poses no quarter or half turn
+//!   reaches, is a flat valley of the image energy that no local step and no other move
+//!   leaves.
 //!
-//! Align, lay, the turns about a body's own axes and the exchanges ask for an orientation
-//! at `t`; the launch spin that reaches it is solved by Newton's method on the free flight
-//! ([`spin_reaching`]), since adding `angle / t` to the spin turns a tumbling block
-//! somewhere else.
+//! Align, lay, the turns about a body's own axes, the seats and the exchanges ask for
+//! an orientation at `t`; the launch spin that reaches it is solved by Newton's method
+//! on the free flight ([`spin_reaching`]), since adding `angle / t` to the spin turns a
+//! tumbling block somewhere else.
 //!
 //! A move guesses a depth from the size of a shadow that is often wrong itself (a body
 //! left too low behind a contact), so the few moves of a pass that make the best
 //! pictures are **polished**: each body they moved slides along its line of sight, a
 //! few steps of shrinking size, while the picture gets better ([`Search::polish`]).
 //!
-//! A move changes a body's launch velocity only (its spin is kept, or turned): the centre
-//! of mass of a free flight in a vacuum is at `c0 + v t + g t^2 / 2` at `t`, so the
-//! velocity that puts it at a point is exact. Every candidate is evaluated like any
-//! sample and ranked by the solver's rank (contacts first under the constraint mode); the
-//! best one is taken when it ranks better than the current best, and the search repeats
-//! from it. A pass costs at most `n (n - 1) + 2 n + 15 m + 18 k + 1` samples for `n`
-//! launched bodies of which `m` are not spheres and `k` are meshes with three distinct
-//! principal moments, and at most [`POLISHED`] times 6 per moved body for the polish;
-//! each fit of the polish costs 2 samples more; a pose fit draws at most
-//! `1 + 12 POSE_LEVELS POSE_SWEEPS` (241) shadows of one block, which are not samples
-//! (no flight, no contact search).
+//! A move changes a body's launch velocity only (its spin is kept, or turned): the
+//! centre of mass of a free flight in a vacuum is at `c0 + v t + g t^2 / 2` at `t`, so
+//! the velocity that puts it at a point is exact. Every candidate is evaluated like any
+//! sample and ranked by the solver's rank (contacts first under the constraint mode);
+//! the best one is taken when it ranks better than the current best, and the search
+//! repeats from it. A pass costs at most `n (n - 1) + 2 n + 15 m + 18 k + 1` samples
+//! for `n` launched bodies of which `m` are not spheres and `k` are meshes with three
+//! distinct principal moments, and at most [`POLISHED`] times 6 per moved body for the
+//! polish; each fit of the polish costs 2 samples more; a pose fit draws at most `1 +
+//! 12 POSE_LEVELS POSE_SWEEPS` (241) shadows of one block, which are not samples (no
+//! flight, no contact search). The seats of a first pass cost at most `s + SEAT_PAIRS`
+//! samples for `s` meshes, and draw about `3 r 64` shadows per seat scanned (`r` rolls:
+//! 1 or 6) and `12 SEAT_STEPS.1 POSE_SWEEPS` (336) per pose refined.
+
+mod pose;
+mod spin;
 
 use glam::{DMat3, DQuat, DVec2, DVec3};
+
+use pose::{fit_and_launch, fits_pose, Seats, SEAT_KEPT, SEAT_PAIRS};
+pub use spin::spin_reaching;
+use spin::{launch_to, seat_guesses, turn_spin};
 
 use crate::energy::{Term, Weights, DIVERGED_ENERGY};
 use crate::evaluate::{Evaluation, Held, Problem, Workspace};
 use crate::geometry::shape::Shape;
 use crate::scene::Launch;
 use crate::shadow::mask::{Mask, Moments};
-use crate::sim::flight::{FlightConfig, FreeFlight, LaunchState};
+use crate::sim::flight::{FreeFlight, LaunchState};
 
 /// Fraction of the light-to-receiver distance (along a line of sight) that a moved body's
 /// centre may take, at least: a body closer to the light than this casts a shadow over
@@ -301,8 +321,17 @@ pub fn improve(
         })
         .sum::<usize>();
     let exchanges_wanted = pairs <= MAX_EXCHANGE_PAIRS;
-    for _ in 0..options.max_moves {
+    let vary: Vec<bool> = (0..scene.occluders.len())
+        .map(|k| movable.contains(&k))
+        .collect();
+    let meshes: Vec<usize> = movable
+        .iter()
+        .copied()
+        .filter(|&i| matches!(scene.occluders[i].shape, Shape::Mesh(_)))
+        .collect();
+    for pass in 0..options.max_moves {
         let current = problem.evaluate_held(held, params, weights, ws);
+        let wrong = problem.target.mask.xor_count(&ws.mask) as i64;
         // The orientations at `t` of the launch kept (the offers below overwrite `ws`).
         let current_poses = ws.poses.clone();
         let turned: Vec<DQuat> = current_poses.iter().map(|p| p.1).collect();
@@ -488,11 +517,68 @@ pub fn improve(
                 }
             }
         }
+        // Seat the meshes (`seat_pose`), in the first pass only: a scan of every pose
+        // costs a few thousand shadows of one body, and a seat that the first pass did
+        // not take is rarely taken after a smaller move.
+        if pass == 0 {
+            let seats = Seats {
+                problem,
+                held,
+                vary: &vary,
+                now: &current_poses,
+                sights: &sights,
+            };
+            let mut offer_seats =
+                |seated: &[(usize, (DVec3, DQuat))], search: &mut Search, ws: &mut Workspace| {
+                    candidate.copy_from_slice(params);
+                    for &(b, pose) in seated {
+                        let guesses = seat_guesses(
+                            problem,
+                            b,
+                            Launch::get(params, b).angular_velocity,
+                            turned[b],
+                            pose.1,
+                        );
+                        if !launch_to(problem, b, pose, &guesses, &mut candidate, &mut flight) {
+                            return;
+                        }
+                    }
+                    let bodies: Vec<usize> = seated.iter().map(|s| s.0).collect();
+                    offer(&candidate, &bodies, search, ws);
+                };
+            // Each on its own place ...
+            for &i in &meshes {
+                if let Some((cost, pose)) = seats.own(i, ws) {
+                    if cost < wrong {
+                        offer_seats(&[(i, pose)], &mut search, ws);
+                    }
+                }
+            }
+            // ... and two of a kind each on the other's: every pair scanned, the best
+            // refined.
+            let mut scanned: Vec<(i64, usize, usize)> = Vec::new();
+            for (a, &i) in meshes.iter().enumerate() {
+                for &j in &meshes[a + 1..] {
+                    if !exchanges_wanted || !exchangeable(scene, i, j) {
+                        continue;
+                    }
+                    if let Some((cost, _)) = seats.pair(i, j, 0, ws) {
+                        scanned.push((cost, i, j));
+                    }
+                }
+            }
+            scanned.sort();
+            for &(_, i, j) in scanned.iter().take(SEAT_PAIRS) {
+                if let Some((cost, [pi, pj])) = seats.pair(i, j, SEAT_KEPT, ws) {
+                    if cost < wrong {
+                        offer_seats(&[(i, pi), (j, pj)], &mut search, ws);
+                    }
+                }
+            }
+            ws.poses.copy_from_slice(&current_poses);
+        }
         // Every block fitted to the picture on its pose at `t`, one after the other
         // (`fit_pose`), and launched there.
-        let vary: Vec<bool> = (0..scene.occluders.len())
-            .map(|k| movable.contains(&k))
-            .collect();
         let is_block = |i: usize| fits_pose(&scene.occluders[i].shape);
         {
             candidate.copy_from_slice(params);
@@ -682,20 +768,25 @@ fn send(
     own: Sight,
     area: f64,
 ) -> DVec3 {
-    let scene = &problem.scene;
-    let light = scene.camera.light;
-    let mut depth = own.depth * (own.area / area).sqrt();
-    // Keep the body's lowest point above the table (for a level table under the light).
+    let light = problem.scene.camera.light;
+    let depth = own.depth * (own.area / area).sqrt();
+    let com = light + (on_receiver - light) * allowed_depth(problem, i, on_receiver, depth);
+    aim(problem, params, i, com);
+    com
+}
+
+/// `depth` along the light's line through `on_receiver`, kept where body `i`'s lowest
+/// point stays above the table (for a level table under the light) and within
+/// [`MIN_DEPTH`] and the receiver.
+fn allowed_depth(problem: &Problem, i: usize, on_receiver: DVec3, mut depth: f64) -> f64 {
+    let light = problem.scene.camera.light;
     if let Some(top) = lowest_centre(problem, i) {
         let drop = light.z - on_receiver.z;
         if drop > 0.0 && light.z > top {
             depth = depth.min((light.z - top) / drop);
         }
     }
-    let depth = depth.clamp(MIN_DEPTH, 1.0);
-    let com = light + (on_receiver - light) * depth;
-    aim(problem, params, i, com);
-    com
+    depth.clamp(MIN_DEPTH, 1.0)
 }
 
 /// [`send`] body `i` (now `own`) to a part of the picture, `(area, centroid)` as
@@ -774,142 +865,6 @@ fn elongation(m: &Moments) -> Option<f64> {
     let root = (0.25 * (a - c) * (a - c) + b * b).sqrt();
     let (large, small) = (half + root, half - root);
     (small > 0.0).then(|| large / small)
-}
-
-/// Set body `i`'s launch spin in `params` so that its orientation at `t`, `now`, turns by
-/// `rotation` (a world axis and an angle): by adding `angle / t` about the axis to the
-/// spin, which is exact only for a spin about a principal axis, or, when `exact`, by
-/// [`spin_reaching`] from there (the added spin where Newton does not converge).
-fn turn_spin(
-    problem: &Problem,
-    params: &mut [f64],
-    i: usize,
-    now: DQuat,
-    (axis, angle): (DVec3, f64),
-    exact: bool,
-    flight: &mut FreeFlight,
-) {
-    let mut launch = Launch::get(params, i);
-    let guess = launch.angular_velocity + axis * (angle / problem.scene.t);
-    launch.angular_velocity = if exact {
-        let want = DQuat::from_axis_angle(axis, angle) * now;
-        spin_reaching(problem, i, want, guess, flight).unwrap_or(guess)
-    } else {
-        guess
-    };
-    launch.set(params, i);
-}
-
-/// Newton iterations of [`spin_reaching`] on the coarse flight, at most.
-const NEWTON_STEPS: usize = 12;
-
-/// Iterations of [`spin_reaching`] on the exact flight, at most, after Newton's method
-/// on the coarse one.
-const CHORD_STEPS: usize = 6;
-
-/// Rotation per RK4 step (rad, at the fastest the body's spin may get) of the coarse
-/// flight on which [`spin_reaching`] runs Newton's method: about 1e-4 of the turn's error
-/// at `t`, where the exact flight's steps of 0.02 rad cost five times as much.
-const COARSE_ANGLE: f64 = 0.1;
-
-/// The launch spin that turns body `i` to the orientation `want` at `t` in free flight,
-/// from `guess`; `None` when it does not converge to 1e-6 rad. Adding `angle / t` about
-/// an axis to the spin is exact only for a spin about a principal axis; a tumbling block
-/// needs this to turn where a move asks.
-///
-/// Newton's method (a finite-difference Jacobian, halved steps where a full one does not
-/// get closer) runs on a coarse flight: RK4 on a fixed number of steps set by the guess
-/// ([`COARSE_ANGLE`]), so that the miss is smooth in the spin (the exact flight's step
-/// count follows the spin, and a finite difference across a change of it is noise).
-/// Chord steps with the last Jacobian then bring the exact flight's miss under 1e-6 rad.
-/// For a body with two equal moments both flights are the exact closed form.
-pub fn spin_reaching(
-    problem: &Problem,
-    i: usize,
-    want: DQuat,
-    guess: DVec3,
-    flight: &mut FreeFlight,
-) -> Option<DVec3> {
-    let scene = &problem.scene;
-    let o = &scene.occluders[i];
-    let t = scene.t;
-    let limit = crate::evaluate::MAX_TURN / t;
-    if !guess.is_finite() || guess.length() > limit {
-        return None;
-    }
-    let k = o.mass.principal_inertia;
-    // The spin's greatest speed in flight is at most |w| I_max / I_min.
-    let turn = guess.length() * k.max_element() / k.min_element() * t;
-    let steps = (turn / COARSE_ANGLE).ceil().max(1.0);
-    let coarse = FlightConfig {
-        rk4_max_step: t / steps,
-        rk4_max_angle: f64::INFINITY,
-    };
-    let mut miss = |w: DVec3, cfg: &FlightConfig| -> DVec3 {
-        let launch = LaunchState {
-            origin: o.position,
-            orientation: o.orientation,
-            velocity: DVec3::ZERO,
-            angular_velocity: w,
-        };
-        flight.reset(&o.mass, launch, scene.gravity, t, cfg);
-        let d = want.conjugate() * flight.orientation(t);
-        if d.w < 0.0 { -d } else { d }.to_scaled_axis()
-    };
-    let mut w = guess;
-    let mut r = miss(w, &coarse);
-    let mut jacobian = None;
-    for _ in 0..NEWTON_STEPS {
-        if !r.is_finite() || w.length() > limit {
-            return None;
-        }
-        // The chord steps need a Jacobian, so a guess that already meets the coarse
-        // flight still gets one below.
-        if r.length() < 1e-6 && jacobian.is_some() {
-            break;
-        }
-        let h = 1e-6 * (1.0 + w.length());
-        let j = DMat3::from_cols(
-            (miss(w + DVec3::X * h, &coarse) - r) / h,
-            (miss(w + DVec3::Y * h, &coarse) - r) / h,
-            (miss(w + DVec3::Z * h, &coarse) - r) / h,
-        );
-        let det = j.determinant();
-        if det.is_nan() || det.abs() <= 1e-12 {
-            return None;
-        }
-        let inverse = j.inverse();
-        jacobian = Some(inverse);
-        if r.length() < 1e-6 {
-            break;
-        }
-        let step = -(inverse * r);
-        let mut lambda = 1.0;
-        loop {
-            let next = w + step * lambda;
-            let rn = miss(next, &coarse);
-            if rn.length() < r.length() {
-                (w, r) = (next, rn);
-                break;
-            }
-            lambda *= 0.5;
-            if lambda < 1.0 / 64.0 {
-                return None;
-            }
-        }
-    }
-    let inverse = jacobian?;
-    for _ in 0..=CHORD_STEPS {
-        let r = miss(w, &problem.flight);
-        if !r.is_finite() || w.length() > limit {
-            return None;
-        }
-        if r.length() < 1e-6 {
-            return Some(w);
-        }
-        w -= inverse * r;
-    }
-    None
 }
 
 /// A body whose long axis is already within this cosine of its part's direction is not
@@ -1025,159 +980,6 @@ fn own_axes(mass: &crate::geometry::shape::MassProperties) -> Option<[DVec3; 3]>
     distinct.then(|| [DVec3::X, DVec3::Y, DVec3::Z].map(|e| mass.principal_frame * e))
 }
 
-/// Turn (rad) of the first steps of [`fit_pose`] about each world axis.
-const POSE_TURN: f64 = 0.1;
-/// Shift (pixels of its shadow on the receiver) of the first steps of [`fit_pose`]
-/// across the line of sight.
-const POSE_SHIFT: f64 = 3.0;
-/// Change of depth (a fraction of it) of the first steps of [`fit_pose`].
-const POSE_DEPTH: f64 = 0.03;
-/// Times [`fit_pose`] halves its steps; it sweeps each step size until a sweep gains
-/// nothing, at most [`POSE_SWEEPS`] times.
-const POSE_LEVELS: usize = 5;
-const POSE_SWEEPS: usize = 4;
-
-/// A better pose at `t` for body `i`, searched on the pose itself: the shadow of the
-/// body at its pose in `ws.poses`, drawn over `others` (every other shadow), against the
-/// target, by a compass search over turns about the world axes, shifts across its line
-/// of sight and changes of depth. A launch spin reaches an orientation at `t` through
-/// the whole tumbling flight, where a small change of spin turns the body anywhere; a
-/// wrongly tilted block whose outline is near its part's is mended here in pixels, and
-/// the spin that reaches the pose is then solved for. Returns the centre of mass and
-/// orientation found (`ws.poses[i]` holds it) when it draws fewer wrong pixels than the
-/// pose it started from.
-fn fit_pose(
-    problem: &Problem,
-    i: usize,
-    others: &Mask,
-    ws: &mut Workspace,
-) -> Option<(DVec3, DQuat)> {
-    let scene = &problem.scene;
-    let o = &scene.occluders[i];
-    let light = scene.camera.light;
-    let local = o.mass.local_com;
-    let (origin, q0) = ws.poses[i];
-    let com0 = origin + q0 * local;
-    let normal = scene.receiver.normal;
-    let down = (scene.receiver.center - light).dot(normal);
-    let depth = (com0 - light).dot(normal) / down;
-    if !(MIN_DEPTH..=1.0).contains(&depth) {
-        return None;
-    }
-    let floor = lowest_centre(problem, i);
-    let mut only = vec![false; scene.occluders.len()];
-    only[i] = true;
-    let target = &problem.target.mask;
-    // The wrong pixels of the whole picture with the body's shadow `s` drawn over the
-    // others: those of the others alone, plus the pixels of `s` on neither the target
-    // nor another shadow, minus those of `s` on bare target. Counted on `s` alone, whose
-    // rows are few, rather than on the whole canvas.
-    let base = others.xor_count(target) as i64;
-    let mut dark = others.clone();
-    dark.or_assign(target);
-    let bare = target.and_not(others);
-    let cost = |com: DVec3, q: DQuat, ws: &mut Workspace| -> i64 {
-        if floor.is_some_and(|z| com.z < z) {
-            return i64::MAX;
-        }
-        ws.poses[i] = (com - q * local, q);
-        problem.shadow_only(&only, ws);
-        let s = &ws.mask;
-        base + s.count() as i64 - s.and_count(&dark) as i64 - s.and_count(&bare) as i64
-    };
-    let sight = (com0 - light).normalize();
-    let e1 = sight.any_orthonormal_vector();
-    let e2 = sight.cross(e1);
-    let c = &problem.canvas;
-    let pixel = (c.pixel_to_world(1.0, 0.0) - c.pixel_to_world(0.0, 0.0)).length();
-    let shift = POSE_SHIFT * pixel * depth;
-    let (mut com, mut q) = (com0, q0);
-    let start = cost(com, q, ws);
-    let mut best = start;
-    let mut h = 1.0;
-    for _ in 0..POSE_LEVELS {
-        for _ in 0..POSE_SWEEPS {
-            let mut gained = false;
-            for k in 0..6 {
-                for sign in [1.0, -1.0] {
-                    let (tc, tq) = match k {
-                        0..=2 => {
-                            let axis = [DVec3::X, DVec3::Y, DVec3::Z][k];
-                            (com, DQuat::from_axis_angle(axis, sign * h * POSE_TURN) * q)
-                        }
-                        3 => (com + e1 * (sign * h * shift), q),
-                        4 => (com + e2 * (sign * h * shift), q),
-                        _ => (light + (com - light) * (1.0 + sign * h * POSE_DEPTH), q),
-                    };
-                    let e = cost(tc, tq, ws);
-                    if e < best {
-                        (best, com, q) = (e, tc, tq.normalize());
-                        gained = true;
-                        break;
-                    }
-                }
-            }
-            if !gained {
-                break;
-            }
-        }
-        h *= 0.5;
-    }
-    ws.poses[i] = (com - q * local, q);
-    (best < start).then_some((com, q))
-}
-
-/// [`fit_pose`] body `i` (whose pose at `t` `ws.poses` holds, as for every body in
-/// `vary`) on the picture of the held bodies and the other bodies of `vary`, and launch
-/// it there in `candidate`: its spin by [`spin_reaching`] and its velocity by [`aim`].
-/// `true` when it moved; otherwise `candidate` and its pose are unchanged.
-#[allow(clippy::too_many_arguments)]
-fn fit_and_launch(
-    problem: &Problem,
-    held: &Held,
-    vary: &[bool],
-    i: usize,
-    candidate: &mut [f64],
-    ws: &mut Workspace,
-    flight: &mut FreeFlight,
-) -> bool {
-    let mut which = vary.to_vec();
-    which[i] = false;
-    problem.shadow_held_and(held, &which, ws);
-    let others = ws.mask.clone();
-    let kept = ws.poses[i];
-    let Some((com, q)) = fit_pose(problem, i, &others, ws) else {
-        ws.poses[i] = kept;
-        return false;
-    };
-    let mut launch = Launch::get(candidate, i);
-    // The turn added to the spin as the first guess (exact for a spin about a principal
-    // axis): Newton's method on a tumbling body's flight can stray from a guess a whole
-    // turn away.
-    let d = q * kept.1.conjugate();
-    let turn = if d.w < 0.0 { -d } else { d }.to_scaled_axis();
-    let guess = launch.angular_velocity + turn / problem.scene.t;
-    match spin_reaching(problem, i, q, guess, flight) {
-        Some(w) => {
-            launch.angular_velocity = w;
-            launch.set(candidate, i);
-            aim(problem, candidate, i, com);
-            true
-        }
-        None => {
-            ws.poses[i] = kept;
-            false
-        }
-    }
-}
-
-/// Whether [`fit_pose`] is tried on a body of this shape: blocks only. A sphere has no
-/// orientation, and on the hand-made THE THINKER the chess pieces fitted so ended lower
-/// (IoU 0.905 / 0.900 / 0.925 on seeds 1 to 3, against 0.915 / 0.908 / 0.916).
-fn fits_pose(shape: &Shape) -> bool {
-    matches!(shape, Shape::Cuboid { .. })
-}
-
 /// Move body `i` (seen as `own` before a turn that `params` now holds) at the same depth
 /// so that its own shadow's centroid is back where it was: a turn keeps the centre of
 /// mass, which an asymmetric body's shadow does not surround evenly. The shadow is drawn
@@ -1268,35 +1070,6 @@ mod tests {
         assert!((axes[0] - DQuat::from_rotation_z(0.3) * DVec3::X).length() < 1e-12);
         assert!(own_axes(&mass(DVec3::new(1.776e-6, 1.9044e-5, 1.9047e-5))).is_none());
         assert!(own_axes(&mass(DVec3::splat(2e-6))).is_none());
-    }
-
-    #[test]
-    fn spin_reaching_finds_the_spin_of_a_tumbling_block() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/fly");
-        let p = Problem::new(crate::scene::load(&dir).unwrap());
-        let mut flight = FreeFlight::default();
-        let o = &p.scene.occluders[0];
-        let t = p.scene.t;
-        // A tumble about no principal axis, several turns long.
-        let w0 = DVec3::new(4.0, -7.0, 11.0);
-        let launch = LaunchState {
-            origin: o.position,
-            orientation: o.orientation,
-            velocity: DVec3::ZERO,
-            angular_velocity: w0,
-        };
-        flight.reset(&o.mass, launch, p.scene.gravity, t, &p.flight);
-        let want = flight.orientation(t);
-        // Where the naive guess (the spin plus a turn over t) lands, Newton corrects it.
-        let guess = w0 + DVec3::new(0.3, 0.2, -0.25);
-        let w = spin_reaching(&p, 0, want, guess, &mut flight).expect("converges");
-        let launch = LaunchState {
-            angular_velocity: w,
-            ..launch
-        };
-        flight.reset(&o.mass, launch, p.scene.gravity, t, &p.flight);
-        let d = want.conjugate() * flight.orientation(t);
-        assert!(d.xyz().length() < 1e-6, "{w} misses by {d}");
     }
 
     #[test]
