@@ -85,7 +85,7 @@ use glam::{DMat3, DQuat, DVec2, DVec3};
 
 use pose::{fit_and_launch, fits_pose, Seats, SEAT_KEPT, SEAT_PAIRS};
 pub use spin::spin_reaching;
-use spin::{launch_to, seat_guesses, turn_spin};
+use spin::{launch_to, spin_guesses, turn_spin};
 
 use crate::energy::{Term, Weights, DIVERGED_ENERGY};
 use crate::evaluate::{Evaluation, Held, Problem, Workspace};
@@ -532,7 +532,7 @@ pub fn improve(
                 |seated: &[(usize, (DVec3, DQuat))], search: &mut Search, ws: &mut Workspace| {
                     candidate.copy_from_slice(params);
                     for &(b, pose) in seated {
-                        let guesses = seat_guesses(
+                        let guesses = spin_guesses(
                             problem,
                             b,
                             Launch::get(params, b).angular_velocity,

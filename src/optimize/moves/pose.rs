@@ -8,7 +8,7 @@
 
 use glam::{DQuat, DVec2, DVec3};
 
-use super::spin::{launch_to, turn_between};
+use super::spin::{launch_to, spin_guesses};
 use super::{allowed_depth, lowest_centre, Sight, MIN_DEPTH, REVOLUTION};
 use crate::evaluate::{Held, Problem, Workspace};
 use crate::geometry::shape::Shape;
@@ -158,14 +158,13 @@ impl<'a> Seat<'a> {
     fn place(
         &self,
         q: DQuat,
-        (centroid, area, depth): (DVec2, f64, f64),
+        (centroid, area, mut depth): (DVec2, f64, f64),
         ws: &mut Workspace,
     ) -> (i64, DVec3) {
         let light = self.problem.scene.camera.light;
         let c = &self.problem.canvas;
         let want = c.pixel_to_world(centroid.x, centroid.y);
         let mut on_receiver = want;
-        let mut depth = depth;
         let mut com =
             light + (on_receiver - light) * allowed_depth(self.problem, self.i, on_receiver, depth);
         for _ in 0..2 {
@@ -277,7 +276,9 @@ pub(super) fn seat_pose(
         None => (mass.long_axis(), SEAT_ROLLS),
     };
     let from = now * axis;
-    let mut best: Vec<(i64, DVec3, DQuat)> = Vec::with_capacity(kept + 2);
+    // A scan (`kept` 0) keeps its best pose too.
+    let keep = kept.max(1);
+    let mut best: Vec<(i64, DVec3, DQuat)> = Vec::with_capacity(keep + 1);
     for d in sphere_directions(SEAT_DIRECTIONS) {
         let tilted = DQuat::from_rotation_arc(from, d) * now;
         for r in 0..rolls {
@@ -288,9 +289,9 @@ pub(super) fn seat_pose(
                 continue;
             }
             let at = best.partition_point(|b| b.0 <= cost);
-            if at < kept.max(1) {
+            if at < keep {
                 best.insert(at, (cost, com, q));
-                best.truncate(kept.max(1));
+                best.truncate(keep);
             }
         }
     }
@@ -385,12 +386,12 @@ pub(super) fn fit_and_launch(
         ws.poses[i] = kept;
         return false;
     };
-    // The turn added to the spin as the first guess (exact for a spin about a principal
-    // axis): Newton's method on a tumbling body's flight can stray from a guess a whole
-    // turn away.
-    let guess =
-        Launch::get(candidate, i).angular_velocity + turn_between(kept.1, q) / problem.scene.t;
-    if launch_to(problem, i, (com, q), &[guess], candidate, flight) {
+    // The first guess only, the turn added to the spin: a fit turns the block a little
+    // from where it is, and Newton's method on a tumbling body's flight can stray from a
+    // guess a whole turn away.
+    let spin = Launch::get(candidate, i).angular_velocity;
+    let guesses = spin_guesses(problem, i, spin, kept.1, q);
+    if launch_to(problem, i, (com, q), &guesses[..1], candidate, flight) {
         true
     } else {
         ws.poses[i] = kept;

@@ -1,6 +1,6 @@
 //! Launch spins that reach an orientation at `t`: [`spin_reaching`] solves for the
 //! spin by Newton's method on the free flight, [`launch_to`] launches a body to a pose
-//! from the best of a few first guesses ([`seat_guesses`]), [`turn_spin`] turns a body
+//! from the slowest spin of a few first guesses ([`spin_guesses`]), [`turn_spin`] turns a body
 //! about a world axis. Adding `angle / t` to a spin is exact only about a principal
 //! axis; a tumbling block needs the solve.
 
@@ -148,9 +148,10 @@ pub fn spin_reaching(
 }
 
 /// Launch body `i` in `candidate` so that at `t` its centre of mass is at `com` and its
-/// orientation `q`: its spin by [`spin_reaching`] from the first of `guesses` that
-/// converges, its velocity by [`aim`]; `false`, and `candidate` unchanged, when none
-/// does.
+/// orientation `q`: its spin the slowest that [`spin_reaching`] converges to from
+/// `guesses` (a faster tumble makes every later flight of the body dearer: its RK4
+/// steps are bounded by angle), its velocity by [`aim`]; `false`, and `candidate`
+/// unchanged, when no guess converges.
 pub(super) fn launch_to(
     problem: &Problem,
     i: usize,
@@ -182,7 +183,7 @@ pub(super) fn turn_between(from: DQuat, to: DQuat) -> DVec3 {
 /// spin about a principal axis), and the turn from its launch orientation alone (a
 /// seat is often far from `now`, and Newton's method on a tumbling flight strays from
 /// a guess a whole turn away).
-pub(super) fn seat_guesses(
+pub(super) fn spin_guesses(
     problem: &Problem,
     i: usize,
     spin: DVec3,
