@@ -53,6 +53,16 @@
 //!   face, or a king and a queen on each other's parts in poses no quarter or half turn
 //!   reaches, is a flat valley of the image energy that no local step and no other move
 //!   leaves.
+//! - **split** a part between a hidden block and another, in the first pass of a call
+//!   too ([`Seats::splits`](pose::Seats::splits)): a block whose shadow adds fewer
+//!   than [`HIDDEN`](pose::HIDDEN) of its pixels to the picture (hidden under the
+//!   others' shadows) is seated, as a mesh is, on one side of another block's part cut
+//!   across its long axis, and that block on the other side; the partners are the
+//!   [`SPLIT_PARTNERS`](pose::SPLIT_PARTNERS) blocks with the most wrong pixels around their shadows. One
+//!   block drawn across two parts, the block meant for one of them hidden under a
+//!   third, is a state where moving either alone makes the picture worse: the hidden
+//!   block sent to the sliver of bare target beside the long shadow covers little,
+//!   and the long shadow pulled back bares what the hidden block does not yet cover.
 //!
 //! Align, lay, the turns about a body's own axes, the seats and the exchanges ask for
 //! an orientation at `t`; the launch spin that reaches it is solved by Newton's method
@@ -76,7 +86,10 @@
 //! 12 POSE_LEVELS POSE_SWEEPS` (241) shadows of one block, which are not samples (no
 //! flight, no contact search). The seats of a first pass cost at most `s + SEAT_PAIRS`
 //! samples for `s` meshes, and draw about `3 r 64` shadows per seat scanned (`r` rolls:
-//! 1 or 6) and `12 SEAT_STEPS.1 POSE_SWEEPS` (336) per pose refined.
+//! 1 or 6) and `12 SEAT_STEPS.1 POSE_SWEEPS` (336) per pose refined. The splits cost at
+//! most [`SPLITS`](pose::SPLITS) samples more, and draw two seats' scans for each of at most
+//! `SPLIT_HIDDEN SPLIT_PARTNERS 2 SPLIT_CUTS.len()` (36) cuts, only where a block is
+//! hidden.
 
 mod pose;
 mod spin;
@@ -572,6 +585,21 @@ pub fn improve(
                 if let Some((cost, [pi, pj])) = seats.pair(i, j, SEAT_KEPT, ws) {
                     if cost < wrong {
                         offer_seats(&[(i, pi), (j, pj)], &mut search, ws);
+                    }
+                }
+            }
+            // ... and a hidden block seated beside another on that one's part, cut in
+            // two: every cut scanned, the best refined.
+            let blocks: Vec<usize> = movable
+                .iter()
+                .copied()
+                .filter(|&i| fits_pose(&scene.occluders[i].shape))
+                .collect();
+            for (r, j, [place_r, place_j]) in seats.split_scan(&blocks, &bare, ws) {
+                let two = seats.two((r, place_r), (j, place_j), SEAT_KEPT, ws);
+                if let Some((cost, [pr, pj])) = two {
+                    if cost < wrong {
+                        offer_seats(&[(r, pr), (j, pj)], &mut search, ws);
                     }
                 }
             }

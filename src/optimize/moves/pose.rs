@@ -1,5 +1,6 @@
 //! Pose searches at `t` in pixels: [`fit_pose`] mends a block's pose on its own part,
-//! [`seat_pose`] scans a mesh's poses over a place of the picture; both draw one body's
+//! [`seat_pose`] scans a body's poses over a place of the picture (a mesh's place, or
+//! a side of a part that a hidden block shares, [`Seats::splits`]); both draw one body's
 //! shadow ([`Seat`]) over the others' and count wrong pixels, then
 //! [`launch_to`] reaches the pose found.
 //!
@@ -15,6 +16,11 @@ use crate::geometry::shape::Shape;
 use crate::scene::Launch;
 use crate::shadow::mask::Mask;
 use crate::sim::flight::FreeFlight;
+
+/// A place of the picture for a body's shadow, as [`Seat::place`] takes it: centroid
+/// (canvas pixels), area (pixels) and the depth of a body that casts it (0 at the
+/// light, 1 on the receiver), where the search for its own depth starts.
+pub(super) type Place = (DVec2, f64, f64);
 
 /// Turn (rad) of the first steps of [`fit_pose`] about each world axis.
 pub(super) const POSE_TURN: f64 = 0.1;
@@ -158,7 +164,7 @@ impl<'a> Seat<'a> {
     fn place(
         &self,
         q: DQuat,
-        (centroid, area, mut depth): (DVec2, f64, f64),
+        (centroid, area, mut depth): Place,
         ws: &mut Workspace,
     ) -> (i64, DVec3) {
         let light = self.problem.scene.camera.light;
@@ -266,7 +272,7 @@ pub(super) fn symmetry_axis(mass: &crate::geometry::shape::MassProperties) -> Op
 pub(super) fn seat_pose(
     seat: &Seat,
     now: DQuat,
-    place: (DVec2, f64, f64),
+    place: Place,
     kept: usize,
     ws: &mut Workspace,
 ) -> Option<(i64, DVec3, DQuat)> {
@@ -327,7 +333,7 @@ impl Seats<'_> {
     }
 
     /// Where body `i` casts its shadow now: its centroid, area and depth.
-    fn place(&self, i: usize) -> Option<(DVec2, f64, f64)> {
+    fn place(&self, i: usize) -> Option<Place> {
         let s = self.sights[i]?;
         Some((s.centroid?, s.area, s.depth))
     }
@@ -340,9 +346,7 @@ impl Seats<'_> {
         Some((cost, (com, q)))
     }
 
-    /// Bodies `i` and `j` each seated on the other's place, `i` first over the others'
-    /// shadows, then `j` over those and `i`'s; `kept` as [`seat_pose`] takes it. Returns
-    /// the wrong pixels of the picture and the two poses.
+    /// Bodies `i` and `j` each seated on the other's place ([`Seats::two`]).
     pub(super) fn pair(
         &self,
         i: usize,
@@ -350,17 +354,186 @@ impl Seats<'_> {
         kept: usize,
         ws: &mut Workspace,
     ) -> Option<(i64, [(DVec3, DQuat); 2])> {
-        let (place_i, place_j) = (self.place(i)?, self.place(j)?);
+        self.two((i, self.place(j)?), (j, self.place(i)?), kept, ws)
+    }
+
+    /// Body `i` seated on `place_i` and body `j` on `place_j` (`(centroid, area, depth)`
+    /// as [`Seat::place`] takes them), `i` first over the others' shadows, then `j`
+    /// over those and `i`'s; `kept` as [`seat_pose`] takes it. Returns the wrong pixels
+    /// of the picture and the two poses.
+    pub(super) fn two(
+        &self,
+        (i, place_i): (usize, Place),
+        (j, place_j): (usize, Place),
+        kept: usize,
+        ws: &mut Workspace,
+    ) -> Option<(i64, [(DVec3, DQuat); 2])> {
         let mut others = self.others(&[i, j], ws);
         let seat = Seat::new(self.problem, i, &others);
-        let (_, com_i, q_i) = seat_pose(&seat, self.now[i].1, place_j, kept, ws)?;
+        let (_, com_i, q_i) = seat_pose(&seat, self.now[i].1, place_i, kept, ws)?;
         seat.draw(com_i, q_i, ws);
         others.or_assign(&ws.mask);
         let seat = Seat::new(self.problem, j, &others);
-        let (cost, com_j, q_j) = seat_pose(&seat, self.now[j].1, place_i, kept, ws)?;
+        let (cost, com_j, q_j) = seat_pose(&seat, self.now[j].1, place_j, kept, ws)?;
         Some((cost, [(com_i, q_i), (com_j, q_j)]))
     }
+
+    /// Body `o`'s part of the target: the target pixels its shadow covers now and the
+    /// bare ones connected to them.
+    fn part(&self, o: usize, bare: &Mask, ws: &mut Workspace) -> Mask {
+        ws.poses.copy_from_slice(self.now);
+        let mut only = vec![false; self.vary.len()];
+        only[o] = true;
+        self.problem.shadow_only(&only, ws);
+        let covered = self.problem.target.mask.and(&ws.mask);
+        let mut mine = bare.clone();
+        mine.or_assign(&covered);
+        mine.connected_to(&covered)
+    }
+
+    /// The bodies (of `bodies`) that the picture hardly needs where they are: fewer than
+    /// [`HIDDEN`] of their shadow's pixels are target pixels that no other shadow
+    /// covers (a block hidden under the others' shadows, or cast beside the picture).
+    /// Most hidden first, at most [`SPLIT_HIDDEN`].
+    fn hidden(&self, bodies: &[usize], ws: &mut Workspace) -> Vec<usize> {
+        let mut found: Vec<(f64, usize)> = Vec::new();
+        for &i in bodies {
+            let others = self.others(&[i], ws);
+            ws.poses.copy_from_slice(self.now);
+            let mut only = vec![false; self.vary.len()];
+            only[i] = true;
+            self.problem.shadow_only(&only, ws);
+            let area = ws.mask.count() as f64;
+            let own = ws
+                .mask
+                .and(&self.problem.target.mask)
+                .and_not_count(&others) as f64;
+            if area > 0.0 && own < HIDDEN * area {
+                found.push((own / area, i));
+            }
+        }
+        found.sort_by(|a, b| a.0.total_cmp(&b.0));
+        found.into_iter().take(SPLIT_HIDDEN).map(|f| f.1).collect()
+    }
+
+    /// The places a hidden body and body `j` may share: `j`'s part of the target (the
+    /// target pixels its shadow covers and the bare ones connected to them) cut across
+    /// its long axis at [`SPLIT_CUTS`] of its length, each side a place, `(hidden's
+    /// place, j's place)`, both ways round; and the pixels of `wrong` (those the
+    /// picture gets wrong) within three pixels of `j`'s shadow. Empty when `j` casts no
+    /// shadow on the target.
+    fn splits(
+        &self,
+        j: usize,
+        bare: &Mask,
+        wrong: &Mask,
+        ws: &mut Workspace,
+    ) -> (u64, Vec<[Place; 2]>) {
+        let Some(depth) = self.sights[j].map(|s| s.depth) else {
+            return (0, Vec::new());
+        };
+        let part = self.part(j, bare, ws);
+        // `part` left body `j`'s shadow in the workspace.
+        let near = ws.mask.dilate(3).and_count(wrong);
+        let m = part.moments();
+        let (Some(c), Some([a, b, cc])) = (m.centroid(), m.central_second()) else {
+            return (near, Vec::new());
+        };
+        let angle = 0.5 * (2.0 * b).atan2(a - cc);
+        let axis = DVec2::new(angle.cos(), angle.sin());
+        // The part's pixels by their distance along the axis, to cut at quantiles.
+        let mut along: Vec<f64> = Vec::with_capacity(m.count as usize);
+        for y in 0..part.height() {
+            for x in 0..part.width() {
+                if part.get(x, y) {
+                    along.push((DVec2::new(x as f64, y as f64) - c).dot(axis));
+                }
+            }
+        }
+        along.sort_by(f64::total_cmp);
+        let mut out = Vec::new();
+        for cut in SPLIT_CUTS {
+            let at = along[((along.len() as f64 * cut) as usize).min(along.len() - 1)];
+            let side = |low: bool| {
+                let half = Mask::from_fn(part.width(), part.height(), |x, y| {
+                    part.get(x, y) && ((DVec2::new(x as f64, y as f64) - c).dot(axis) < at) == low
+                });
+                let h = half.moments();
+                h.centroid()
+                    .filter(|_| h.count >= SPLIT_LEAST)
+                    .map(|hc| (hc, h.count, depth))
+            };
+            if let (Some(low), Some(high)) = (side(true), side(false)) {
+                out.push([low, high]);
+                out.push([high, low]);
+            }
+        }
+        (near, out)
+    }
+
+    /// The splits of a part between a hidden block and another worth refining, best
+    /// first, at most [`SPLITS`]: `(hidden, partner, [hidden's place, partner's
+    /// place])`. Each hidden block ([`Seats::hidden`] of `blocks`) is tried with the
+    /// [`SPLIT_PARTNERS`] other blocks with the most wrong pixels around their shadows,
+    /// on every cut of [`Seats::splits`], both seated by a scan ([`Seats::two`], `kept`
+    /// 0) and ranked by the picture's wrong pixels.
+    pub(super) fn split_scan(
+        &self,
+        blocks: &[usize],
+        bare: &Mask,
+        ws: &mut Workspace,
+    ) -> Vec<(usize, usize, [Place; 2])> {
+        let hidden = self.hidden(blocks, ws);
+        if hidden.is_empty() {
+            return Vec::new();
+        }
+        // The pixels the picture gets wrong now: bare target and shadow off it.
+        let mut wrong = self.others(&[], ws);
+        let extra = wrong.and_not(&self.problem.target.mask);
+        wrong.copy_from(bare);
+        wrong.or_assign(&extra);
+        let mut partners = Vec::new();
+        for &j in blocks {
+            let (near, places) = self.splits(j, bare, &wrong, ws);
+            if near > 0 && !places.is_empty() {
+                partners.push((std::cmp::Reverse(near), j, places));
+            }
+        }
+        partners.sort_by_key(|p| (p.0, p.1));
+        let mut scanned = Vec::new();
+        for &r in &hidden {
+            for (_, j, cuts) in partners.iter().filter(|p| p.1 != r).take(SPLIT_PARTNERS) {
+                for &[place_r, place_j] in cuts {
+                    if let Some((cost, _)) = self.two((r, place_r), (*j, place_j), 0, ws) {
+                        scanned.push((cost, r, *j, [place_r, place_j]));
+                    }
+                }
+            }
+        }
+        scanned.sort_by_key(|s| s.0);
+        scanned
+            .into_iter()
+            .take(SPLITS)
+            .map(|(_, r, j, places)| (r, j, places))
+            .collect()
+    }
 }
+
+/// A body whose shadow adds fewer target pixels than this fraction of its area is
+/// hidden ([`Seats::hidden`]).
+pub(super) const HIDDEN: f64 = 0.25;
+/// Hidden bodies split in with another, at most.
+pub(super) const SPLIT_HIDDEN: usize = 2;
+/// Where [`Seats::splits`] cuts a part along its long axis (fractions of its pixels).
+pub(super) const SPLIT_CUTS: [f64; 3] = [1.0 / 3.0, 0.5, 2.0 / 3.0];
+/// Bodies a hidden body is split in with: those with the most wrong pixels around
+/// their shadows.
+pub(super) const SPLIT_PARTNERS: usize = 3;
+/// Pixels a side of a cut holds at least.
+const SPLIT_LEAST: f64 = 16.0;
+/// Splits that [`improve`](super::improve) refines, those whose scans draw the best
+/// pictures.
+pub(super) const SPLITS: usize = 4;
 
 /// [`fit_pose`] body `i` (whose pose at `t` `ws.poses` holds, as for every body in
 /// `vary`) on the picture of the held bodies and the other bodies of `vary`, and launch
