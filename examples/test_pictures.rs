@@ -4,7 +4,7 @@
 //! (DejaVu Sans's airplane, chess knight and umbrella symbols), 640 x 480, black on
 //! white, each with the box of objects it is to be made of, stated before any solve.
 //!
-//! Twelve sets: set 1 (`tools/test-pictures`), the pictures `bsa new` was developed on;
+//! Fifteen sets: set 1 (`tools/test-pictures`), the pictures `bsa new` was developed on;
 //! set 2 (`tools/test-pictures-2`), drawn after the code was final and solved once, for
 //! the figures of the issue: letters, digits, outlines, a filled star, a snowman of
 //! discs and two DejaVu symbols (heart and spade) as silhouettes; set 3
@@ -39,9 +39,13 @@
 //! exchanges (the Greek capitals gamma, theta, phi and psi, the Cyrillic zhe and sha,
 //! the closing brace and parenthesis, the comma, the heavy cross and envelope symbols,
 //! an arc of five discs, and the telephone and heavy heart symbols), its boxes stated
-//! as for set 8.
+//! as for set 8; sets 13, 14 and 15 (`tools/test-pictures-13` to `-15`), each drawn
+//! after a later session's last solver change (Cyrillic and Greek letters, a figure of
+//! discs and two silhouettes for the chess set each; see their functions), their boxes
+//! stated by one rule, a double unit for each long straight stroke and units along the
+//! curves and the short strokes.
 //!
-//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 12,
+//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 15,
 //! default 1; DIR default `tools/test-pictures[-SET]`): writes
 //! `DIR/<name>.png` and `DIR/manifest.tsv` (name, objects, extra `bsa new` options),
 //! which `scripts/new-suite.sh` reads. The output depends only on the font file and
@@ -327,6 +331,53 @@ fn disc_cross(x: f64, y: f64) -> bool {
     ]
     .iter()
     .any(|&(cx, cy)| (x - cx).hypot(y - cy) <= 30.0)
+}
+
+/// Set 15: defined in a later session after its last change to the solver (a part
+/// split between a hidden block and another), its objects stated with it as for set
+/// 14 (a double unit for each long straight stroke, units along curves and short
+/// strokes), and run once. The two pictures for the chess set are the black spade
+/// and club suits, filled silhouettes.
+fn pictures_15() -> Vec<(&'static str, Shape, String, &'static str)> {
+    let chess_stage = "--width 0.96 --light-height 3";
+    let glyph = |name, c, objects: String| (name, Shape::Glyph(c, 6), objects, "");
+    let chess = |name, c| (name, Shape::Glyph(c, 0), "chess".to_string(), chess_stage);
+    vec![
+        glyph("short-i", '\u{0419}', format!("{DOUBLE}*3,{UNIT}*2")),
+        glyph("ka", '\u{041A}', format!("{DOUBLE}*3")),
+        glyph("yu", '\u{042E}', format!("{DOUBLE},{UNIT}*7")),
+        glyph("hard-sign", '\u{042A}', format!("{DOUBLE},{UNIT}*5")),
+        glyph("ha", '\u{0425}', format!("{DOUBLE}*2")),
+        glyph("small-alpha", '\u{03B1}', format!("{DOUBLE},{UNIT}*5")),
+        glyph("small-beta", '\u{03B2}', format!("{DOUBLE},{UNIT}*5")),
+        glyph("small-sigma", '\u{03C3}', format!("{UNIT}*7")),
+        glyph("small-rho", '\u{03C1}', format!("{DOUBLE},{UNIT}*4")),
+        glyph("small-chi", '\u{03C7}', format!("{DOUBLE}*2")),
+        glyph("small-psi", '\u{03C8}', format!("{DOUBLE},{UNIT}*4")),
+        (
+            "disc-triangle",
+            Shape::Drawn(disc_triangle),
+            "sphere:0.07*6".to_string(),
+            "",
+        ),
+        chess("spade", '\u{2660}'),
+        chess("club", '\u{2663}'),
+    ]
+}
+
+fn disc_triangle(x: f64, y: f64) -> bool {
+    // Six discs of radius 30 on a triangle: one at each corner, 150 pixels from its
+    // middle, and one halfway along each side.
+    let corner = |k: usize| {
+        let a = (90.0 + 120.0 * k as f64).to_radians();
+        (150.0 * a.cos(), 150.0 * a.sin())
+    };
+    (0..3)
+        .flat_map(|k| {
+            let (a, b) = (corner(k), corner((k + 1) % 3));
+            [a, (0.5 * (a.0 + b.0), 0.5 * (a.1 + b.1))]
+        })
+        .any(|(cx, cy)| (x - cx).hypot(y - cy) <= 30.0)
 }
 
 /// Set 14: defined in a later session after its last change to the solver (blocks
@@ -1008,7 +1059,8 @@ fn main() -> Result<(), Box<dyn Error>> {
         "12" => (pictures_12(), "tools/test-pictures-12"),
         "13" => (pictures_13(), "tools/test-pictures-13"),
         "14" => (pictures_14(), "tools/test-pictures-14"),
-        other => return Err(format!("SET must be 1 to 14, got {other:?}").into()),
+        "15" => (pictures_15(), "tools/test-pictures-15"),
+        other => return Err(format!("SET must be 1 to 15, got {other:?}").into()),
     };
     let dir = args
         .get(1)
