@@ -435,39 +435,13 @@ impl Seats<'_> {
         let part = self.part(j, bare, ws);
         // `part` left body `j`'s shadow in the workspace.
         let near = ws.mask.dilate(3).and_count(wrong);
-        let m = part.moments();
-        let (Some(c), Some([a, b, cc])) = (m.centroid(), m.central_second()) else {
-            return (near, Vec::new());
-        };
-        let angle = 0.5 * (2.0 * b).atan2(a - cc);
-        let axis = DVec2::new(angle.cos(), angle.sin());
-        // The part's pixels by their distance along the axis, to cut at quantiles.
-        let mut along: Vec<f64> = Vec::with_capacity(m.count as usize);
-        for y in 0..part.height() {
-            for x in 0..part.width() {
-                if part.get(x, y) {
-                    along.push((DVec2::new(x as f64, y as f64) - c).dot(axis));
-                }
-            }
-        }
-        along.sort_by(f64::total_cmp);
-        let mut out = Vec::new();
-        for cut in SPLIT_CUTS {
-            let at = along[((along.len() as f64 * cut) as usize).min(along.len() - 1)];
-            let side = |low: bool| {
-                let half = Mask::from_fn(part.width(), part.height(), |x, y| {
-                    part.get(x, y) && ((DVec2::new(x as f64, y as f64) - c).dot(axis) < at) == low
-                });
-                let h = half.moments();
-                h.centroid()
-                    .filter(|_| h.count >= SPLIT_LEAST)
-                    .map(|hc| (hc, h.count, depth))
-            };
-            if let (Some(low), Some(high)) = (side(true), side(false)) {
-                out.push([low, high]);
-                out.push([high, low]);
-            }
-        }
+        let out = cut_across(&part, &SPLIT_CUTS)
+            .into_iter()
+            .flat_map(|[(cl, al), (ch, ah)]| {
+                let (low, high) = ((cl, al, depth), (ch, ah, depth));
+                [[low, high], [high, low]]
+            })
+            .collect();
         (near, out)
     }
 
@@ -517,6 +491,47 @@ impl Seats<'_> {
             .map(|(_, r, j, places)| (r, j, places))
             .collect()
     }
+}
+
+/// `part` cut across its long axis (of its second moments) at each fraction of its
+/// pixels in `cuts`, counted along that axis: the centroid (pixels) and area (pixels) of
+/// the side below the cut and of the side above, for each cut whose sides both hold
+/// [`SPLIT_LEAST`] pixels or more.
+fn cut_across(part: &Mask, cuts: &[f64]) -> Vec<[(DVec2, f64); 2]> {
+    let m = part.moments();
+    let (Some(c), Some([a, b, cc])) = (m.centroid(), m.central_second()) else {
+        return Vec::new();
+    };
+    let angle = 0.5 * (2.0 * b).atan2(a - cc);
+    let axis = DVec2::new(angle.cos(), angle.sin());
+    let along = |x: usize, y: usize| (DVec2::new(x as f64, y as f64) - c).dot(axis);
+    // The part's pixels by their distance along the axis, to cut at quantiles.
+    let mut sorted: Vec<f64> = Vec::with_capacity(m.count as usize);
+    for y in 0..part.height() {
+        for x in 0..part.width() {
+            if part.get(x, y) {
+                sorted.push(along(x, y));
+            }
+        }
+    }
+    sorted.sort_by(f64::total_cmp);
+    let mut out = Vec::new();
+    for &cut in cuts {
+        let at = sorted[((sorted.len() as f64 * cut) as usize).min(sorted.len() - 1)];
+        let side = |low: bool| {
+            let half = Mask::from_fn(part.width(), part.height(), |x, y| {
+                part.get(x, y) && (along(x, y) < at) == low
+            });
+            let h = half.moments();
+            h.centroid()
+                .filter(|_| h.count >= SPLIT_LEAST)
+                .map(|hc| (hc, h.count))
+        };
+        if let (Some(low), Some(high)) = (side(true), side(false)) {
+            out.push([low, high]);
+        }
+    }
+    out
 }
 
 /// A body whose shadow adds fewer target pixels than this fraction of its area is
@@ -603,6 +618,46 @@ mod tests {
         // Spread, not bunched: the mean is close to the centre.
         let mean = dirs.iter().sum::<DVec3>() / dirs.len() as f64;
         assert!(mean.length() < 0.05, "{mean}");
+    }
+
+    #[test]
+    fn a_part_is_cut_across_its_long_axis_at_fractions_of_its_pixels() {
+        // A bar 40 pixels long and 10 wide, lying along x, then standing along y.
+        for lying in [true, false] {
+            let part = Mask::from_fn(64, 64, |x, y| {
+                let (u, v) = if lying { (x, y) } else { (y, x) };
+                (10..50).contains(&u) && (20..30).contains(&v)
+            });
+            let cuts = cut_across(&part, &[0.25, 0.5]);
+            assert_eq!(cuts.len(), 2);
+            for ([(low, a_low), (high, a_high)], share) in cuts.into_iter().zip([0.25, 0.5]) {
+                assert_eq!(a_low + a_high, 400.0);
+                assert!((a_low - 400.0 * share).abs() <= 10.0, "{a_low} for {share}");
+                // Each side's centroid lies on the bar's centre line, in its own half.
+                let (along_low, across_low) = if lying {
+                    (low.x, low.y)
+                } else {
+                    (low.y, low.x)
+                };
+                let (along_high, across_high) = if lying {
+                    (high.x, high.y)
+                } else {
+                    (high.y, high.x)
+                };
+                assert!((across_low - across_high).abs() < 1e-9);
+                let end = 10.0 + 40.0 * share;
+                assert!((along_low - (10.0 + end) / 2.0).abs() < 1.0, "{along_low}");
+                assert!(
+                    (along_high - (end + 50.0) / 2.0).abs() < 1.0,
+                    "{along_high}"
+                );
+            }
+        }
+        // A side under the least pixels is no place: a cut at the bar's very end.
+        let bar = Mask::from_fn(64, 64, |x, y| {
+            (10..50).contains(&x) && (20..30).contains(&y)
+        });
+        assert!(cut_across(&bar, &[0.01]).is_empty());
     }
 
     #[test]
