@@ -89,7 +89,9 @@
 //! 1 or 6) and `12 SEAT_STEPS.1 POSE_SWEEPS` (336) per pose refined. The splits cost at
 //! most [`SPLITS`](pose::SPLITS) samples more, and draw two seats' scans for each of at most
 //! `SPLIT_HIDDEN SPLIT_PARTNERS 2 SPLIT_CUTS.len()` (36) cuts, only where a block is
-//! hidden.
+//! hidden; finding the hidden blocks draws, once a call, each block's shadow alone and
+//! the others' without it (1.05 to 1.1 times the solve's time on the planted blocks
+//! where no block is hidden).
 
 mod pose;
 mod spin;
