@@ -469,13 +469,9 @@ fn exchanges_give_two_blocks_each_others_pose_and_place() {
     );
 }
 
-/// Two chess pieces of `scenes/thinker/pieces`, planted (IoU 1), with the weights of
-/// their scene's last stage.
-fn planted_pieces(
-    name: &str,
-    first: &str,
-    second: &str,
-) -> (Problem, Vec<f64>, bsa::energy::Weights) {
+/// Two chess pieces of `scenes/thinker/pieces`, planted (IoU 1), and the first piece's
+/// orientation at `t` in the planted launch.
+fn planted_pieces(name: &str, first: &str, second: &str) -> (Problem, Vec<f64>, glam::DQuat) {
     let pieces = root().join("scenes/thinker/pieces");
     let objects = format!(
         "mesh:{}/{first}.obj/900,mesh:{}/{second}.obj/900",
@@ -484,8 +480,10 @@ fn planted_pieces(
     );
     let (p, planted) = planted(name, &objects, "0.96");
     let w = p.scene.stages.last().unwrap().weights;
-    assert!(p.evaluate(&planted, &w, &mut p.workspace()).iou > 0.9999);
-    (p, planted, w)
+    let mut ws = p.workspace();
+    assert!(p.evaluate(&planted, &w, &mut ws).iou > 0.9999);
+    let now = ws.poses[0].1;
+    (p, planted, now)
 }
 
 /// The planted launch with the first piece turned to `want` at `t`, its spin solved on
@@ -521,12 +519,9 @@ fn assert_moves_mend(p: &Problem, params: &mut [f64]) {
 
 #[test]
 fn moves_mirror_a_knight_that_shows_its_profile_the_wrong_way_round() {
-    let (p, planted, w) = planted_pieces("moves-mirror", "knight", "pawn");
-    let mut ws = p.workspace();
-    p.evaluate(&planted, &w, &mut ws);
+    let (p, planted, now) = planted_pieces("moves-mirror", "knight", "pawn");
     // The knight turned half a turn about its own long axis at `t` (a tumbling knight: its
     // spin is solved on the flight): its profile mirrored, about its centre of mass.
-    let now = ws.poses[0].1;
     let axis = now * p.scene.occluders[0].mass.long_axis();
     let want = glam::DQuat::from_axis_angle(axis, std::f64::consts::PI) * now;
     let mut params = turned_at_t(&p, &planted, want, glam::DVec3::from_slice(&planted[3..6]));
@@ -536,12 +531,9 @@ fn moves_mirror_a_knight_that_shows_its_profile_the_wrong_way_round() {
 
 #[test]
 fn moves_seat_a_piece_turned_far_from_its_pose_back_on_its_part() {
-    let (p, planted, w) = planted_pieces("moves-seat", "rook", "king");
-    let mut ws = p.workspace();
-    p.evaluate(&planted, &w, &mut ws);
+    let (p, planted, now) = planted_pieces("moves-seat", "rook", "king");
     // The rook turned by 2 rad about a slanted axis at `t`, about its centre of mass: a
     // wrong face, far from every quarter and half turn of its pose.
-    let now = ws.poses[0].1;
     let axis = glam::DVec3::new(1.0, 2.0, 3.0).normalize();
     let want = glam::DQuat::from_axis_angle(axis, 2.0) * now;
     let guess = glam::DVec3::from_slice(&planted[3..6]) + axis * (2.0 / p.scene.t);

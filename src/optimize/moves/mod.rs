@@ -752,10 +752,7 @@ fn sights(
             }
             continue;
         }
-        let covered = problem.target.mask.and(&ws.mask);
-        let mut mine = bare.clone();
-        mine.or_assign(&covered);
-        let part = mine.connected_to(&covered);
+        let part = part_of(&problem.target.mask, &ws.mask, bare);
         // A part that another body's shadow borders is shared: its size is not this
         // body's to take.
         let others = full.and_not(&ws.mask);
@@ -784,6 +781,15 @@ fn sights(
         });
     }
     out
+}
+
+/// A body's part of the target, from its own shadow `own`: the target pixels it covers
+/// and the bare ones (`bare`) connected to them.
+fn part_of(target: &Mask, own: &Mask, bare: &Mask) -> Mask {
+    let covered = target.and(own);
+    let mut mine = bare.clone();
+    mine.or_assign(&covered);
+    mine.connected_to(&covered)
 }
 
 /// Set body `i`'s launch velocity in `params` so that its centre of mass is at `t` on

@@ -381,14 +381,16 @@ impl Seats<'_> {
     /// Body `o`'s part of the target: the target pixels its shadow covers now and the
     /// bare ones connected to them.
     fn part(&self, o: usize, bare: &Mask, ws: &mut Workspace) -> Mask {
+        self.alone(o, ws);
+        super::part_of(&self.problem.target.mask, &ws.mask, bare)
+    }
+
+    /// Draw body `i`'s shadow alone, at its pose now, into `ws.mask`.
+    fn alone(&self, i: usize, ws: &mut Workspace) {
         ws.poses.copy_from_slice(self.now);
         let mut only = vec![false; self.vary.len()];
-        only[o] = true;
+        only[i] = true;
         self.problem.shadow_only(&only, ws);
-        let covered = self.problem.target.mask.and(&ws.mask);
-        let mut mine = bare.clone();
-        mine.or_assign(&covered);
-        mine.connected_to(&covered)
     }
 
     /// The bodies (of `bodies`) that the picture hardly needs where they are: fewer than
@@ -399,10 +401,7 @@ impl Seats<'_> {
         let mut found: Vec<(f64, usize)> = Vec::new();
         for &i in bodies {
             let others = self.others(&[i], ws);
-            ws.poses.copy_from_slice(self.now);
-            let mut only = vec![false; self.vary.len()];
-            only[i] = true;
-            self.problem.shadow_only(&only, ws);
+            self.alone(i, ws);
             let area = ws.mask.count() as f64;
             let own = ws
                 .mask
