@@ -303,7 +303,24 @@ pub fn solve(
         let mut candidates: Vec<f64> = Vec::new();
         let mut restart = 0;
         let (mut lambda, mut population) = (0, stage.population);
+        // Trades of places among bodies, tried once in the last stage when its picture
+        // stays below `TRADE_IOU`: `trading` while that call of the moves trades,
+        // `traded` after. Trades are judged on the picture without the hints, and once
+        // one is taken the stage goes on without them: the hints say where the design
+        // sent each object, and a cycle of objects each on another's part is the
+        // design's own mistake that the hints hold in place (the planted chess 10800: a
+        // queen, a king and a bishop each on the next one's part, kept there by 183
+        // pixels of hints against 354 wrong ones).
+        let (mut trading, mut traded) = (false, false);
+        let mut last_stop = None;
+        let given = stage;
+        let unhinted = {
+            let mut s = given.clone();
+            s.weights.0[Term::Hint as usize] = 0.0;
+            s
+        };
         let stop = loop {
+            let stage = if trading || traded { &unhinted } else { given };
             // One CMA-ES run from the stage's best so far: the first with the stage's
             // population, each restart (IPOP) with twice the previous one and the
             // stage's initial step, so that it searches wider than the run that stalled.
@@ -312,6 +329,9 @@ pub fn solve(
             // contact, which only replaces the best once its contact is gone.
             let rank = |e: &Evaluation| rank_value(e, scene.contacts);
             let run_start = best_eval;
+            if trading {
+                best_eval = problem.evaluate_held(&held, &best_params, &stage.weights, &mut ws);
+            }
             let moved = moves::improve(
                 problem,
                 &held,
@@ -321,8 +341,13 @@ pub fn solve(
                 &mut best_params,
                 &mut best_eval,
                 moves::MoveOptions {
-                    max_moves: stage.vary.len(),
+                    max_moves: if trading {
+                        TRADE_MOVES
+                    } else {
+                        stage.vary.len()
+                    },
                     polish_single: restart > 0 || stage.vary.len() > 1,
+                    trades: trading,
                 },
                 &mut ws,
                 &mut |e: &Evaluation| records.push(sample_record(k, iteration, stage, e)),
@@ -331,10 +356,17 @@ pub fn solve(
             if moved.accepted > 0 {
                 best_mask.copy_from(&ws.mask);
             }
+            let was_trading = std::mem::take(&mut trading);
+            if was_trading && moved.accepted == 0 {
+                // No trade drew a better picture: the stage ends as its last run did,
+                // judged with its hints again.
+                best_eval = problem.evaluate_held(&held, &best_params, &given.weights, &mut ws);
+                break last_stop;
+            }
             // Exchanges of two bodies' poses and places, each refined by rounds of
             // one-body runs, before the stage's first run (see `exchange`).
             let template = scene.stages.iter().rev().find(|s| s.vary.len() == 1);
-            if let Some(template) = template.filter(|_| restart == 0 && !robust) {
+            if let Some(template) = template.filter(|_| restart == 0 && !traded && !robust) {
                 // What the solve drew before this stage, and the stage so far.
                 let drawn = reports.iter().map(|r| r.samples).sum::<usize>() + samples;
                 let better = exchange(
@@ -358,7 +390,9 @@ pub fn solve(
             // A run starts from the promising launch (a better picture with a contact)
             // only when no move was taken: after a move, the new best is the better
             // place to refine.
-            let start_from = moved.promising.filter(|_| moved.accepted == 0);
+            let start_from = moved
+                .promising
+                .filter(|_| moved.accepted == 0 || was_trading);
             let from = start_from.as_deref().unwrap_or(&best_params);
             problem.stage_start(from, &stage.vary, &mut x0);
             let config = CmaesConfig {
@@ -446,6 +480,19 @@ pub fn solve(
                 && restart < stage.restarts
                 && best_eval.iou < stage.restart_iou
                 && run_moved_picture(stage.restart_gain, &run_start, &best_eval, scene.contacts);
+            let trade = !restartable
+                && !interrupted
+                && !traded
+                && !robust
+                && k + 1 == scene.stages.len()
+                && stop != Some(StopReason::TargetReached)
+                && best_eval.iou < TRADE_IOU;
+            if trade {
+                // Moves with trades, then (when one is taken) a run of the stage's
+                // population from there.
+                (trading, traded, last_stop) = (true, true, stop);
+                continue;
+            }
             if !restartable {
                 break stop;
             }
@@ -521,6 +568,22 @@ pub fn solve(
     let s = summarize(problem, &params, &reports, &run, Some(timing));
     (s, records)
 }
+
+/// The last stage's picture below which its bodies trade places (`moves::improve` with
+/// `trades`), once, after its runs: two or three bodies of different shapes each drawn
+/// on the next one's part (a long block end-on on a small block's part, the small one
+/// high on a medium one's, the medium one high on the long one's) is a state no move of
+/// one or two bodies mends. The trades cost 1.25 and 1.28 times the summed solve time
+/// of 14 planted boxes12 and 14 chess problems (`bsa solve` of their designed scenes),
+/// paid only where the picture is poor; a picture at 0.985 or more is left alone.
+const TRADE_IOU: f64 = 0.985;
+
+/// Moves taken at most by the call of the moves that trades (each pass trades: a trade
+/// of two often leaves a third body to trade). Against as many moves as bodies, on 14
+/// planted boxes12 and 14 chess problems: 13 % and 18 % less solve time, for IoU 0.9401
+/// instead of 0.9473 on chess 10602 (0.9368 with no trades) and 0.9864 instead of
+/// 0.9867 on chess 10604, the others the same.
+const TRADE_MOVES: usize = 3;
 
 /// The record of one sample of stage `k` (`stage`) at `iteration`.
 fn sample_record(k: usize, iteration: usize, stage: &Stage, e: &Evaluation) -> SampleRecord {

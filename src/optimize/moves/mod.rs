@@ -63,6 +63,17 @@
 //!   third, is a state where moving either alone makes the picture worse: the hidden
 //!   block sent to the sliver of bare target beside the long shadow covers little,
 //!   and the long shadow pulled back bares what the hidden block does not yet cover.
+//! - **trade** places among bodies of one kind and different shapes, in every pass of
+//!   a call that asks for it ([`MoveOptions::trades`]; the solver asks once, in its
+//!   last stage, when the picture stays poor, and judges it without the hints): two or
+//!   three blocks, or meshes where few, each seated, as a mesh is, on the place of the
+//!   next, the cycles ranked by a table of seats
+//!   ([`Seats::trade_scan`](pose::Seats::trade_scan)). A shadow's size is its body's
+//!   size over its depth, so a long block end-on and low can draw a small block's part,
+//!   the small block high up a medium one's, and the medium one high up the long one's
+//!   (or a queen the king's part, the king the bishop's, the bishop the queen's): three
+//!   wrong parts at once, where a swap of two leaves one wrong and often draws a worse
+//!   picture than the one it leaves. Such a call seats the meshes in every pass too.
 //!
 //! Align, lay, the turns about a body's own axes, the seats and the exchanges ask for
 //! an orientation at `t`; the launch spin that reaches it is solved by Newton's method
@@ -91,7 +102,10 @@
 //! `SPLIT_HIDDEN SPLIT_PARTNERS 2 SPLIT_CUTS.len()` (36) cuts, only where a block is
 //! hidden; finding the hidden blocks draws, once a call, each block's shadow alone and
 //! the others' without it (1.05 to 1.1 times the solve's time on the planted blocks
-//! where no block is hidden).
+//! where no block is hidden). The trades draw one seat (a scan and its best pose
+//! refined) for each ordered pair of bodies of a group of different shapes (at most `b (b
+//! - 1)` for `b` blocks, [`MAX_MESH_TRADES`] for meshes) and cost at most
+//! [`TRADES`](pose::TRADES) samples more a pass, each polished.
 
 mod pose;
 mod spin;
@@ -282,6 +296,12 @@ pub struct MoveOptions {
     /// where the search ends (on the 飞 example, a polished turn taken so left the hook
     /// stroke 0.004 of IoU worse).
     pub polish_single: bool,
+    /// Trade places among bodies of one kind and different shapes, and seat the meshes,
+    /// in every pass ([`Seats::trade_scan`](pose::Seats::trade_scan)); a call that asks
+    /// for trades where no group may trade (no two blocks of different sizes, and no two
+    /// meshes of different shapes among at most [`MAX_MESH_TRADES`] ordered pairs)
+    /// moves nothing.
+    pub trades: bool,
 }
 
 /// Greedy moves of the occluders in `vary` from `params` (the launch of every
@@ -310,7 +330,28 @@ pub fn improve(
         .filter(|&i| scene.occluders[i].launched)
         .collect();
     let mut report = MoveReport::default();
-    if movable.is_empty() {
+    let blocks: Vec<usize> = movable
+        .iter()
+        .copied()
+        .filter(|&i| fits_pose(&scene.occluders[i].shape))
+        .collect();
+    let meshes: Vec<usize> = movable
+        .iter()
+        .copied()
+        .filter(|&i| matches!(scene.occluders[i].shape, Shape::Mesh(_)))
+        .collect();
+    // The groups that trade places: the blocks, and the meshes where few enough.
+    let shape = |i: usize| &scene.occluders[i].shape;
+    let trades: Vec<&[usize]> = [&blocks[..], &meshes[..]]
+        .into_iter()
+        .filter(|group| {
+            options.trades
+                && group.iter().any(|&i| shape(i) != shape(group[0]))
+                && (group.len() * group.len().saturating_sub(1) <= MAX_MESH_TRADES
+                    || fits_pose(shape(group[0])))
+        })
+        .collect();
+    if movable.is_empty() || (options.trades && trades.is_empty()) {
         return report;
     }
     let mut search = Search {
@@ -338,11 +379,6 @@ pub fn improve(
     let exchanges_wanted = pairs <= MAX_EXCHANGE_PAIRS;
     let vary: Vec<bool> = (0..scene.occluders.len())
         .map(|k| movable.contains(&k))
-        .collect();
-    let meshes: Vec<usize> = movable
-        .iter()
-        .copied()
-        .filter(|&i| matches!(scene.occluders[i].shape, Shape::Mesh(_)))
         .collect();
     for pass in 0..options.max_moves {
         let current = problem.evaluate_held(held, params, weights, ws);
@@ -535,7 +571,7 @@ pub fn improve(
         // Seat the meshes (`seat_pose`), in the first pass only: a scan of every pose
         // costs a few thousand shadows of one body, and a seat that the first pass did
         // not take is rarely taken after a smaller move.
-        if pass == 0 {
+        if pass == 0 || options.trades {
             let seats = Seats {
                 problem,
                 held,
@@ -592,16 +628,24 @@ pub fn improve(
             }
             // ... and a hidden block seated beside another on that one's part, cut in
             // two: every cut scanned, the best refined.
-            let blocks: Vec<usize> = movable
-                .iter()
-                .copied()
-                .filter(|&i| fits_pose(&scene.occluders[i].shape))
-                .collect();
             for (r, j, [place_r, place_j]) in seats.split_scan(&blocks, &bare, ws) {
                 let two = seats.two((r, place_r), (j, place_j), SEAT_KEPT, ws);
                 if let Some((cost, [pr, pj])) = two {
                     if cost < wrong {
                         offer_seats(&[(r, pr), (j, pj)], &mut search, ws);
+                    }
+                }
+            }
+            // ... and, when the caller asks, blocks of different sizes each on the next
+            // one's place: the cycles the scans rank best, refined.
+            for group in &trades {
+                for cycle in seats.trade_scan(group, ws) {
+                    if let Some((cost, poses)) = seats.many(&cycle, SEAT_KEPT, ws) {
+                        if cost < wrong {
+                            let seated: Vec<(usize, (DVec3, DQuat))> =
+                                cycle.iter().map(|c| c.0).zip(poses).collect();
+                            offer_seats(&seated, &mut search, ws);
+                        }
                     }
                 }
             }
@@ -932,6 +976,13 @@ fn lays(problem: &Problem, i: usize, now: DQuat, com: DVec3, angle: f64) -> Vec<
 /// pillars 36, which took the hand-made tbc from 1.42 to 1.93 s (seed 1, for no gain);
 /// the planted problems' six chess pieces make 15 pairs.
 const MAX_EXCHANGE_PAIRS: usize = 30;
+
+/// Meshes trade places ([`MoveOptions::trades`]) where at most this many ordered pairs
+/// of them are scanned: the six pieces of the planted chess problems make 30, each
+/// scan drawing a few thousand shadows of a mesh; THE THINKER's sixteen would make 240,
+/// several seconds over its solve. Blocks, whose shadows are eight corners, always
+/// trade.
+const MAX_MESH_TRADES: usize = 30;
 
 /// Whether bodies `i` and `j` may exchange poses and places: of one kind (two meshes,
 /// two boxes; a sphere's pose shows nothing) and of different shapes.

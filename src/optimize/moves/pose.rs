@@ -358,9 +358,8 @@ impl Seats<'_> {
     }
 
     /// Body `i` seated on `place_i` and body `j` on `place_j` (`(centroid, area, depth)`
-    /// as [`Seat::place`] takes them), `i` first over the others' shadows, then `j`
-    /// over those and `i`'s; `kept` as [`seat_pose`] takes it. Returns the wrong pixels
-    /// of the picture and the two poses.
+    /// as [`Seat::place`] takes them), `i` first ([`Seats::many`]). Returns the wrong
+    /// pixels of the picture and the two poses.
     pub(super) fn two(
         &self,
         (i, place_i): (usize, Place),
@@ -368,14 +367,113 @@ impl Seats<'_> {
         kept: usize,
         ws: &mut Workspace,
     ) -> Option<(i64, [(DVec3, DQuat); 2])> {
-        let mut others = self.others(&[i, j], ws);
-        let seat = Seat::new(self.problem, i, &others);
-        let (_, com_i, q_i) = seat_pose(&seat, self.now[i].1, place_i, kept, ws)?;
-        seat.draw(com_i, q_i, ws);
-        others.or_assign(&ws.mask);
-        let seat = Seat::new(self.problem, j, &others);
-        let (cost, com_j, q_j) = seat_pose(&seat, self.now[j].1, place_j, kept, ws)?;
-        Some((cost, [(com_i, q_i), (com_j, q_j)]))
+        let (cost, poses) = self.many(&[(i, place_i), (j, place_j)], kept, ws)?;
+        Some((cost, [poses[0], poses[1]]))
+    }
+
+    /// Bodies seated each on its place (`(body, (centroid, area, depth))`), in order:
+    /// the first over the shadows of every body not seated, each next over those and
+    /// the shadows of the bodies seated before it; `kept` as [`seat_pose`] takes it.
+    /// Returns the wrong pixels of the picture and the poses, in order.
+    pub(super) fn many(
+        &self,
+        seated: &[(usize, Place)],
+        kept: usize,
+        ws: &mut Workspace,
+    ) -> Option<(i64, Vec<(DVec3, DQuat)>)> {
+        let bodies: Vec<usize> = seated.iter().map(|s| s.0).collect();
+        let mut others = self.others(&bodies, ws);
+        let mut poses = Vec::with_capacity(seated.len());
+        let mut cost = 0;
+        for (k, &(b, place)) in seated.iter().enumerate() {
+            let seat = Seat::new(self.problem, b, &others);
+            let (c, com, q) = seat_pose(&seat, self.now[b].1, place, kept, ws)?;
+            if k + 1 < seated.len() {
+                seat.draw(com, q, ws);
+                others.or_assign(&ws.mask);
+            }
+            cost = c;
+            poses.push((com, q));
+        }
+        Some((cost, poses))
+    }
+
+    /// Trades of places among `bodies` (of one kind) worth refining, best first, at most
+    /// [`TRADES`]: each two or three bodies of different shapes, each to be seated on
+    /// the place of the next (the last on the first's), as `(body, place)`.
+    ///
+    /// Each body is seated ([`seat_pose`], its scan's best pose refined) on the place of
+    /// every body of another shape, over the picture without the two, once; that seat's
+    /// change of the picture's wrong pixels, added over a cycle to what taking its
+    /// bodies out costs the picture, ranks the cycle. A table of one seat per ordered
+    /// pair (`n (n - 1)` at most) ranks every pair and three-cycle, where seating each
+    /// cycle alone would cost three seats for each of `n (n - 1) (n - 2) / 3`
+    /// three-cycles. (The scan alone ranks blocks as well, but not pieces: a chess
+    /// piece's scanned shadow is off by hundreds of pixels, more than a trade gains.)
+    pub(super) fn trade_scan(
+        &self,
+        blocks: &[usize],
+        ws: &mut Workspace,
+    ) -> Vec<Vec<(usize, Place)>> {
+        let target = &self.problem.target.mask;
+        let shape = |a: usize| &self.problem.scene.occluders[blocks[a]].shape;
+        let whole = self.others(&[], ws).xor_count(target) as i64;
+        // What taking each block out costs the picture (wrong pixels).
+        let out: Vec<i64> = blocks
+            .iter()
+            .map(|&i| self.others(&[i], ws).xor_count(target) as i64 - whole)
+            .collect();
+        // `on[a][b]`: the change of wrong pixels of block `a` seated on `b`'s place, over
+        // the picture without both.
+        let n = blocks.len();
+        let mut on = vec![vec![None; n]; n];
+        for (a, &i) in blocks.iter().enumerate() {
+            for (b, &j) in blocks.iter().enumerate() {
+                let Some(place) = self.place(j).filter(|_| shape(a) != shape(b)) else {
+                    continue;
+                };
+                let seat = Seat::new(self.problem, i, &self.others(&[i, j], ws));
+                if let Some((cost, _, _)) = seat_pose(&seat, self.now[i].1, place, 1, ws) {
+                    on[a][b] = Some(cost - seat.base);
+                }
+            }
+        }
+        let mut cycles: Vec<(i64, Vec<usize>)> = Vec::new();
+        let mut consider = |cycle: &[usize]| {
+            let mut change = 0;
+            for (k, &a) in cycle.iter().enumerate() {
+                let Some(seated) = on[a][cycle[(k + 1) % cycle.len()]] else {
+                    return;
+                };
+                change += out[a] + seated;
+            }
+            cycles.push((change, cycle.to_vec()));
+        };
+        // Each cycle once: its first block the lowest index; a pair has one direction,
+        // three blocks two.
+        for a in 0..n {
+            for b in a + 1..n {
+                consider(&[a, b]);
+                for c in a + 1..n {
+                    if c != b {
+                        consider(&[a, b, c]);
+                    }
+                }
+            }
+        }
+        cycles.sort_by_key(|c| c.0);
+        cycles
+            .into_iter()
+            .take(TRADES)
+            .filter_map(|(_, cycle)| {
+                (0..cycle.len())
+                    .map(|k| {
+                        let next = blocks[cycle[(k + 1) % cycle.len()]];
+                        Some((blocks[cycle[k]], self.place(next)?))
+                    })
+                    .collect()
+            })
+            .collect()
     }
 
     /// Body `o`'s part of the target: the target pixels its shadow covers now and the
@@ -548,6 +646,10 @@ const SPLIT_LEAST: f64 = 16.0;
 /// Splits that [`improve`](super::improve) refines, those whose scans draw the best
 /// pictures.
 pub(super) const SPLITS: usize = 4;
+
+/// Trades that [`improve`](super::improve) refines ([`Seats::trade_scan`]), those
+/// ranked best by the scans.
+pub(super) const TRADES: usize = 4;
 
 /// [`fit_pose`] body `i` (whose pose at `t` `ws.poses` holds, as for every body in
 /// `vary`) on the picture of the held bodies and the other bodies of `vary`, and launch
