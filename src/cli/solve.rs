@@ -266,6 +266,7 @@ fn solve_into(
         threads: opts.threads,
         seed,
         resume: resume_from,
+        skip_trades: false,
     };
     clock.lap("resume and output folder");
     let first_stage = options.resume.as_ref().map_or(0, |s| s.stages_completed);

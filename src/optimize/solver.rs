@@ -47,6 +47,13 @@ pub struct SolveOptions {
     /// Continue a saved solution: its completed stages are skipped and the next stage
     /// starts from its launch values.
     pub resume: Option<Solution>,
+    /// Leave out the trades of the last stage (see `TRADE_IOU`). `bsa new` does, in the
+    /// trial solves that compare its designs: a trade mends a design's wrong assignment
+    /// in one trial and not in another, so that a trial's result would tell less of the
+    /// design and more of the trade (with trades, "to fly" kept a design whose seeds 1
+    /// to 3 solve to 0.9511 / 0.9465 / 0.9454, against 0.9486 / 0.9492 / 0.9489 for the
+    /// one kept without), and each trial would pay for them.
+    pub skip_trades: bool,
 }
 
 /// Progress of one iteration, for progress bars and previews.
@@ -481,6 +488,7 @@ pub fn solve(
                 && best_eval.iou < stage.restart_iou
                 && run_moved_picture(stage.restart_gain, &run_start, &best_eval, scene.contacts);
             let trade = !restartable
+                && !options.skip_trades
                 && !interrupted
                 && !traded
                 && !robust

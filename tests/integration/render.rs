@@ -464,7 +464,8 @@ fn new_keeps_the_design_that_solves_best_and_solve_ends_where_its_trial_did() {
     let at = ceilings.iter().position(|&c| c == ceiling).unwrap();
     let kept = orders.iter().find(|o| o.0 == order).unwrap().1[at];
     assert_eq!(kept, Some(best), "{out}");
-    // The written scene is the design that was tried: its solve ends where the trial did.
+    // The written scene is the design that was tried: its solve ends where the trial did
+    // (the trials leave out the last stage's trades, and fly's solve takes none).
     let solved = d.join("out");
     solve(&dir, &solved, &[]);
     let solution = read_json(&solved.join("solution.json"));

@@ -32,6 +32,7 @@ fn same_seed_gives_bit_identical_solution_with_1_and_2_threads() {
             threads: Some(threads),
             seed: Some(7),
             resume: None,
+            skip_trades: false,
         };
         solver::solve(&p, &opts, &mut solver::Silent, &none)
     };
@@ -47,6 +48,7 @@ fn same_seed_gives_bit_identical_solution_with_1_and_2_threads() {
         threads: Some(2),
         seed: Some(8),
         resume: None,
+        skip_trades: false,
     };
     let (_, rc) = solver::solve(&p, &opts, &mut solver::Silent, &none);
     assert_ne!(ra, rc);
@@ -68,6 +70,7 @@ fn resume_continues_to_the_same_result() {
         threads: Some(2),
         seed: Some(3),
         resume: None,
+        skip_trades: false,
     };
     let none = AtomicUsize::new(0);
     let (full, _) = solver::solve(&p, &opts, &mut solver::Silent, &none);
@@ -110,6 +113,7 @@ fn a_stage_stopped_by_a_second_interrupt_runs_again_on_resume() {
         threads: Some(2),
         seed: Some(5),
         resume: None,
+        skip_trades: false,
     };
     let (stopped, _) = solver::solve(&p, &opts, &mut StopMidFirstStage(&counter), &counter);
     assert_eq!(stopped.stages_completed, 0);
