@@ -398,11 +398,7 @@ fn run_moves(
     p: &Problem,
     params: &mut [f64],
     rank: &dyn Fn(&bsa::evaluate::Evaluation) -> f64,
-) -> (
-    f64,
-    bsa::evaluate::Evaluation,
-    bsa::optimize::moves::MoveReport,
-) {
+) -> Moved {
     run_moves_of(p, &[0, 1], params, rank)
 }
 
@@ -412,26 +408,25 @@ fn run_moves_of(
     vary: &[usize],
     params: &mut [f64],
     rank: &dyn Fn(&bsa::evaluate::Evaluation) -> f64,
-) -> (
-    f64,
-    bsa::evaluate::Evaluation,
-    bsa::optimize::moves::MoveReport,
-) {
+) -> Moved {
     run_moves_trading(p, vary, params, rank, false)
 }
 
-/// [`run_moves_of`], with or without trades of places among blocks.
+/// What a call of the moves did: the IoU before, the evaluation after, its report.
+type Moved = (
+    f64,
+    bsa::evaluate::Evaluation,
+    bsa::optimize::moves::MoveReport,
+);
+
+/// [`run_moves_of`], with or without trades of places among bodies.
 fn run_moves_trading(
     p: &Problem,
     vary: &[usize],
     params: &mut [f64],
     rank: &dyn Fn(&bsa::evaluate::Evaluation) -> f64,
     trades: bool,
-) -> (
-    f64,
-    bsa::evaluate::Evaluation,
-    bsa::optimize::moves::MoveReport,
-) {
+) -> Moved {
     let w = p.scene.stages.last().unwrap().weights;
     let mut ws = p.workspace();
     let mut best = p.evaluate(params, &w, &mut ws);
@@ -634,15 +629,7 @@ fn the_last_stage_trades_pieces_that_the_hints_hold_each_on_another_part() {
     let scene = root.join("tests/fixtures/chess-cycle");
     let out = crate::util::tmpdir("trade-unhinted");
     std::fs::copy(scene.join("stuck.json"), out.join("solution.json")).unwrap();
-    let (ok, _, err) = crate::util::bsa(&[
-        "solve",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--resume",
-        "-q",
-    ]);
-    assert!(ok, "{err}");
+    crate::util::solve(&scene, &out, &["--resume"]);
     let s = crate::util::read_json(&out.join("solution.json"));
     let iou = s["iou"].as_f64().unwrap();
     // 0.9735 when written: the king and the bishop traded.

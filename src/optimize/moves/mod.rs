@@ -568,9 +568,10 @@ pub fn improve(
                 }
             }
         }
-        // Seat the meshes (`seat_pose`), in the first pass only: a scan of every pose
-        // costs a few thousand shadows of one body, and a seat that the first pass did
-        // not take is rarely taken after a smaller move.
+        // Seat the meshes (`seat_pose`), in the first pass only (in every pass of a call
+        // that trades: a trade of two often leaves a third body to seat): a scan of every
+        // pose costs a few thousand shadows of one body, and a seat that the first pass
+        // did not take is rarely taken after a smaller move.
         if pass == 0 || options.trades {
             let seats = Seats {
                 problem,
@@ -636,8 +637,8 @@ pub fn improve(
                     }
                 }
             }
-            // ... and, when the caller asks, blocks of different sizes each on the next
-            // one's place: the cycles the scans rank best, refined.
+            // ... and, when the caller asks, bodies of one kind and different shapes each
+            // on the next one's place: the cycles the table of seats ranks best, refined.
             for group in &trades {
                 for cycle in seats.trade_scan(group, ws) {
                     if let Some((cost, poses)) = seats.many(&cycle, SEAT_KEPT, ws) {
@@ -658,7 +659,7 @@ pub fn improve(
             candidate.copy_from_slice(params);
             ws.poses.copy_from_slice(&current_poses);
             let mut fitted = Vec::new();
-            for &i in movable.iter().filter(|&&i| is_block(i)) {
+            for &i in &blocks {
                 if fit_and_launch(problem, held, &vary, i, &mut candidate, ws, &mut flight) {
                     fitted.push(i);
                 }
