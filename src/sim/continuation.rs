@@ -388,11 +388,12 @@ mod tests {
     use crate::sim::flight::{FlightConfig, FreeFlight, LaunchState};
 
     fn scene_with(occluders: &str) -> Scene {
-        let dir = std::env::temp_dir().join(format!(
-            "bsa-cont-{}-{}",
-            std::process::id(),
-            occluders.len()
-        ));
+        // A folder of its own for each call: tests run side by side, and two scenes
+        // keyed by their text's length (as they were) shared one when the lengths
+        // matched, one test reading the target while the other wrote it.
+        static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!("bsa-cont-{}-{call}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         image::GrayImage::from_fn(64, 48, |x, _| image::Luma([if x < 10 { 0 } else { 255 }]))
             .save(dir.join("t.png"))
