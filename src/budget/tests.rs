@@ -19,7 +19,11 @@ const MICKEY: [f64; 18] = [
 /// A small scene of a tumbling brick (asymmetric box) and a knight (asymmetric mesh,
 /// 0.5 m tall), written to a temporary folder.
 fn box_and_mesh() -> Problem {
-    let d = std::env::temp_dir().join(format!("bsa-budget-{}", std::process::id()));
+    // A folder per call: the tests run in parallel threads of one process, and one
+    // test must not read the scene file while another writes it.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+    let d = std::env::temp_dir().join(format!("bsa-budget-{}-{call}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     let scene = serde_json::json!({
         "name": "dragtest",
