@@ -25,6 +25,8 @@ echo "== cargo fmt --check"
 cargo fmt --check
 echo "== cargo clippy"
 cargo clippy --all-targets --locked -- -D warnings
+echo "== cargo doc (its links checked)"
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --locked --document-private-items
 # The tests that need the validator or bpy are #[ignore]d so that a plain `cargo test`
 # lists them as ignored; --include-ignored runs them too, for real (a missing tool fails).
 echo "== cargo test (with the ignored Blender and validator tests: --include-ignored)"

@@ -9,6 +9,11 @@
 //! ten terms) -> [`evaluate`] (one sample) -> [`optimize`] (stages of CMA-ES) ->
 //! [`output`] (the result schema and files) and [`budget`] (the error budget); [`cli`]
 //! is the glue of the `bsa` binary.
+//!
+//! The modules' docs are written for the developers and name private items (a stage's
+//! constants, its helpers); `cargo doc --document-private-items` renders those links.
+
+#![allow(rustdoc::private_intra_doc_links)]
 
 pub mod budget;
 pub mod cli;

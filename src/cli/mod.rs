@@ -17,6 +17,11 @@
 //! This is the only module that uses `anyhow`, prints, draws progress bars or installs
 //! the Ctrl-C handler; library modules return typed errors.
 
+// The options' doc comments are clap's help text, written for a terminal: `<scene>` and
+// `<name>` there are placeholders of the help, not HTML, and `[default: ...]` is not a
+// link.
+#![allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
+
 mod blend;
 mod blender;
 mod budget;

@@ -1,5 +1,5 @@
 //! Where each object's shadow goes: a greedy cover of the picture by the objects'
-//! magnified top views ([`cover`]).
+//! magnified top views ([`Cover`]).
 //!
 //! Largest object first, each object takes the placement (pose, roll, centre, angle,
 //! magnification) whose shadow gains the most: +1 per target pixel not yet covered,
@@ -76,7 +76,7 @@ impl Frame {
 /// Where one object's shadow goes.
 #[derive(Clone, Debug)]
 pub struct Placement {
-    /// Index of the object (in the order given to [`cover`]).
+    /// Index of the object (in the order given to [`Cover`]).
     pub object: usize,
     /// Index of its pose family and the roll within it.
     pub family: usize,

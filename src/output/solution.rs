@@ -1,11 +1,12 @@
 //! The result files' schema: what `solution.json` and `convergence.csv` hold, and the
 //! check that a saved solution belongs to a scene.
 //!
-//! Main types: [`Solution`] (the whole `solution.json`: per occluder a [`Launch`], every
-//! term as a [`TermValue`], one [`StageReport`] per stage), [`SampleRecord`] (one row of
-//! `convergence.csv`) and [`MismatchError`]. The solver produces these values; `export`
-//! writes and reads them; `eval`, `export`, `validate`, `video`, `budget` and `--resume`
-//! check a loaded one with [`check_solution`] (or [`check_resumable`]) before using it.
+//! Main types: [`Solution`] (the whole `solution.json`: per occluder an
+//! [`OccluderLaunch`], every term as a [`TermValue`], one [`StageReport`] per stage),
+//! [`SampleRecord`] (one row of `convergence.csv`) and [`MismatchError`]. The solver
+//! produces these values; `export` writes and reads them; `eval`, `export`, `validate`,
+//! `video`, `budget` and `--resume` check a loaded one with [`check_solution`] (or
+//! [`check_resumable`]) before using it.
 
 use serde::{Deserialize, Serialize};
 

@@ -115,9 +115,11 @@ pub(super) struct SilEdge {
     pub(super) dir: i32,
 }
 
-/// Reusable buffers for [`ShadowCamera::rasterize_triangles`] and
-/// [`ShadowCamera::rasterize_box`]. They grow to the largest mesh and image seen, then
-/// are reused without allocating.
+/// Reusable buffers for [`rasterize_triangles`] and [`rasterize_box`]. They grow to the
+/// largest mesh and image seen, then are reused without allocating.
+///
+/// [`rasterize_triangles`]: super::camera::ShadowCamera::rasterize_triangles
+/// [`rasterize_box`]: super::camera::ShadowCamera::rasterize_box
 #[derive(Clone, Debug, Default)]
 pub struct RasterScratch {
     /// Homogeneous image coordinates `(px * depth, py * depth, depth)` per vertex.
