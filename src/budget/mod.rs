@@ -155,7 +155,7 @@ pub enum BudgetError {
     Parameters { expected: usize, found: usize },
     #[error(transparent)]
     Mismatch(#[from] MismatchError),
-    #[error("the scene was edited after the solve: the solution's shadow at t now has IoU {now:.6} and {contacts_now} contacts, the solution recorded IoU {recorded:.6} and {contacts_recorded} (solve again, or pass the scene it was made for)")]
+    #[error("the scene or the solution was edited after the solve: the solution's shadow at t now has IoU {now:.6} and {contacts_now} contacts, the solution recorded IoU {recorded:.6} and {contacts_recorded} (solve again, or pass the scene it was made for)")]
     Stale {
         recorded: f64,
         now: f64,

@@ -7,10 +7,10 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 
-use crate::budget::{self, plots, BudgetOptions, Tolerances};
+use crate::budget::{self, plots, BudgetError, BudgetOptions, Tolerances};
 use crate::evaluate::Problem;
 use crate::output::files;
-use crate::sim::drag::DragConfig;
+use crate::sim::drag::{DragConfig, DragError};
 
 use super::progress::BudgetProgress;
 use super::{load, BudgetArgs};
@@ -60,9 +60,13 @@ impl Options {
     }
 
     /// Check every budget option (drag, tolerances, sample counts, threads, threshold)
-    /// against the scene, before any simulation runs.
+    /// against the scene, before any simulation runs. The error names the flag to
+    /// change, then what is wrong with its value.
     fn validate(&self, problem: &Problem) -> Result<()> {
-        budget::validate_options(problem, &self.budget).context("invalid budget options")
+        budget::validate_options(problem, &self.budget).map_err(|e| match flag_of(&e) {
+            Some(flag) => anyhow::anyhow!("{flag}: {e}"),
+            None => anyhow::Error::new(e).context("invalid budget options"),
+        })
     }
 
     /// The output folder and the solution file of [`Options::path`].
@@ -78,6 +82,28 @@ impl Options {
             (path.to_path_buf(), path.join("solution.json"))
         }
     }
+}
+
+/// The command-line flag that sets the value an option error is about (`None` for a
+/// value no flag sets, such as the drag integrator's step).
+fn flag_of(e: &BudgetError) -> Option<&'static str> {
+    Some(match e {
+        BudgetError::Drag(DragError::Density(_)) => "--rho",
+        BudgetError::Drag(DragError::Coefficient { .. }) => "--cd",
+        BudgetError::Tolerance { name, .. } => match *name {
+            "speed" => "--speed-tol",
+            "direction" => "--direction-tol",
+            "spin" => "--spin-tol",
+            "timing" => "--timing-tol",
+            "cd" => "--cd-tol",
+            _ => return None,
+        },
+        BudgetError::Samples { what, .. } if *what == "samples" => "--samples",
+        BudgetError::Samples { what, .. } if *what == "search samples" => "--search-samples",
+        BudgetError::Threads => "--threads",
+        BudgetError::Threshold(_) => "--iou-threshold",
+        _ => return None,
+    })
 }
 
 /// Run the budget, write its files and print a summary.

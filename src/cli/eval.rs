@@ -12,6 +12,10 @@ use crate::scene::Scene;
 
 use super::{load, EvalArgs};
 
+/// Most repetitions of `--profile`: a sample takes up to a few milliseconds, so this
+/// is minutes at most.
+const MAX_PROFILE_REPS: usize = 100_000;
+
 /// The validated options of `bsa eval`.
 pub(super) struct Options {
     scene: PathBuf,
@@ -23,16 +27,19 @@ pub(super) struct Options {
 }
 
 impl Options {
-    /// Nothing can be checked before the scene is loaded: the range of `--stage` is the
-    /// scene's, see [`Options::stage`].
-    pub(super) fn new(args: EvalArgs) -> Options {
-        Options {
+    /// `--profile`'s repetitions are checked here; the range of `--stage` is the
+    /// scene's, checked once it is loaded ([`Options::stage`]).
+    pub(super) fn new(args: EvalArgs) -> Result<Options> {
+        if let Some(reps) = args.profile.filter(|r| !(1..=MAX_PROFILE_REPS).contains(r)) {
+            bail!("--profile must be 1 to {MAX_PROFILE_REPS} repetitions, got {reps}");
+        }
+        Ok(Options {
             scene: args.scene,
             solution: args.solution,
             stage: args.stage,
             json: args.json,
             profile: args.profile,
-        }
+        })
     }
 
     /// The 1-based stage whose weights to use: `--stage`, checked to be one of the
@@ -54,6 +61,17 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let scene = load::scene(&opts.scene)?;
     let k = opts.stage(&scene)?;
     let solution_path = &opts.solution;
+    if solution_path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"))
+    {
+        bail!(
+            "--solution {}: eval reads a solve's solution.json (its terms and stages); `bsa render {} --solution {}` draws the shadow of a launch table",
+            solution_path.display(),
+            opts.scene.display(),
+            solution_path.display()
+        );
+    }
     let s = files::read_solution(solution_path)?;
     let problem = load::problem_for(scene, &s);
     // As budget does: the names, counts and t, and the same shadow when re-evaluated, so
@@ -82,7 +100,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         problem.frame_ious(&s.parameters(), &mut ws)
     };
     let timings = match opts.profile {
-        Some(reps) => problem.profile(&s.parameters(), reps.max(1), &mut ws),
+        Some(reps) => problem.profile(&s.parameters(), reps, &mut ws),
         None => Vec::new(),
     };
     if opts.json {

@@ -96,6 +96,7 @@ pub(super) fn rest_summary(problem: &Problem, track: &Track, after: f64) -> Stri
             "every body at rest {:.2} s after t (no point faster than {REST_SPEED_M_S} m/s for {REST_HOLD_S} s); the animation ends at {end:.2} s",
             since - t
         ),
+        _ if after == 0.0 => format!("the animation ends at t, {end:.2} s (--after 0)"),
         _ => {
             let moving: Vec<String> = problem
                 .scene
@@ -105,6 +106,12 @@ pub(super) fn rest_summary(problem: &Problem, track: &Track, after: f64) -> Stri
                 .filter(|(_, &s)| s >= REST_SPEED_M_S)
                 .map(|(o, s)| format!("{} {s:.3} m/s", o.name))
                 .collect();
+            if moving.is_empty() {
+                // Slow enough at the cap, but not yet for the time that counts as rest.
+                return format!(
+                    "the motion after t stopped at the cap of --after {after} s before the bodies had been still for {REST_HOLD_S} s; the animation ends at {end:.2} s; give a longer --after to see them settle"
+                );
+            }
             format!(
                 "the motion after t stopped at the cap of --after {after} s with {} still moving ({}): the animation ends with them in motion; give a longer --after",
                 moving.len(),

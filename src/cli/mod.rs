@@ -428,7 +428,7 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Check(args) => check::run(&check::Options::new(args)),
         Command::Solve(args) => solve::run(&solve::Options::new(args)?),
-        Command::Eval(args) => eval::run(&eval::Options::new(args)),
+        Command::Eval(args) => eval::run(&eval::Options::new(args)?),
         Command::Export(args) => export::run(&export::Options::new(args)?),
         Command::Validate(args) => validate::run(&validate::Options::new(args)),
         Command::Blend(args) => blend::run(&blend::Options::new(args)?),

@@ -25,16 +25,16 @@ use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 
-use crate::design::inventory::{AutoKind, Inventory, Kind};
+use crate::design::inventory::{Auto, AutoKind, Inventory, Kind};
 use crate::design::launch::{Geometry, Object, Plan};
 use crate::design::picture::Picture;
 use crate::design::plant::{default_strategy, Stage};
-use crate::design::{self, chess, separate, AutoRequest, Order, Request};
+use crate::design::{self, chess, separate, AutoRequest, DesignError, Order, Request};
 use crate::energy::Weights;
 use crate::evaluate::Problem;
 use crate::optimize::solver::{self, Silent, SolveOptions};
 use crate::output::files;
-use crate::scene::Scene;
+use crate::scene::{Contacts, Scene, SceneError};
 
 use super::guard::NothingWritten;
 use super::plant::Design;
@@ -85,39 +85,26 @@ impl Options {
 
 /// One distinct object of the inventory, as the scene file writes it.
 struct Prototype {
+    /// The object as the list gives it (a mesh's path as the user typed it).
+    kind: Kind,
     stem: String,
     shape: Value,
     density: f64,
 }
 
 impl Prototype {
-    /// The object as the user's list names it: `sphere:R`, `box:XxYxZ`, `mesh:FILE`,
-    /// or the chess piece.
+    /// The object as the user's list names it: `sphere:R`, `box:XxYxZ`,
+    /// `mesh:FILE[@SCALE]` (the path as given, not as the scene file writes it), or the
+    /// chess piece.
     fn describe(&self) -> String {
-        let number = |v: &Value| v.as_f64().map_or("?".to_string(), |x| format!("{x}"));
-        if let Some(r) = self.shape.get("sphere").and_then(|s| s.get("radius")) {
-            return format!("sphere:{}", number(r));
-        }
-        if let Some(size) = self.shape.get("box").and_then(|b| b.get("size")) {
-            let parts: Vec<String> = size
-                .as_array()
-                .map_or(Vec::new(), |a| a.iter().map(number).collect());
-            return format!("box:{}", parts.join("x"));
-        }
-        match self
-            .shape
-            .get("mesh")
-            .and_then(|m| m.get("obj"))
-            .and_then(Value::as_str)
-        {
-            Some(obj) if obj.starts_with("pieces/") && self.stem != "mesh" => {
-                format!("the chess {}", self.stem)
+        match &self.kind {
+            Kind::Sphere { radius } => format!("sphere:{radius}"),
+            Kind::Box { size } => format!("box:{}x{}x{}", size[0], size[1], size[2]),
+            Kind::Mesh { obj, scale } if *scale != 1.0 => {
+                format!("mesh:{}@{scale}", obj.display())
             }
-            Some(obj) => match self.shape["mesh"].get("scale").and_then(Value::as_f64) {
-                Some(scale) if scale != 1.0 => format!("mesh:{obj}@{scale}"),
-                _ => format!("mesh:{obj}"),
-            },
-            None => self.stem.clone(),
+            Kind::Mesh { obj, .. } => format!("mesh:{}", obj.display()),
+            Kind::Chess { piece } => format!("the chess {piece}"),
         }
     }
 }
@@ -133,10 +120,9 @@ fn prototype(dir: &Path, kind: &Kind, density: f64) -> Result<Prototype> {
                 .and_then(|s| s.to_str())
                 .unwrap_or("mesh")
                 .to_string();
-            (
-                stem,
-                json!({"mesh": {"obj": mesh_path(dir, obj), "scale": scale}}),
-            )
+            let path = mesh_path(dir, obj)
+                .with_context(|| format!("--objects: mesh:{}", obj.display()))?;
+            (stem, json!({"mesh": {"obj": path, "scale": scale}}))
         }
         Kind::Chess { piece } => {
             let rel = format!("pieces/{piece}.obj");
@@ -155,6 +141,7 @@ fn prototype(dir: &Path, kind: &Kind, density: f64) -> Result<Prototype> {
         }
     };
     Ok(Prototype {
+        kind: kind.clone(),
         stem,
         shape,
         density,
@@ -162,16 +149,21 @@ fn prototype(dir: &Path, kind: &Kind, density: f64) -> Result<Prototype> {
 }
 
 /// An OBJ path as the scene in `dir` names it: relative when the file is inside `dir`,
-/// else absolute.
-fn mesh_path(dir: &Path, obj: &Path) -> String {
-    let abs = std::fs::canonicalize(obj).unwrap_or_else(|_| obj.to_path_buf());
-    match std::fs::canonicalize(dir)
-        .ok()
-        .and_then(|d| abs.strip_prefix(d).ok().map(Path::to_path_buf))
-    {
-        Some(rel) => rel.display().to_string(),
-        None => abs.display().to_string(),
-    }
+/// else absolute. The path is the user's, relative to the current folder: when it
+/// cannot be resolved there, this is an error, never a path the scene would read
+/// relative to `dir` (and so perhaps another file).
+fn mesh_path(dir: &Path, obj: &Path) -> Result<String> {
+    let abs = std::fs::canonicalize(obj)
+        .with_context(|| format!("cannot find the OBJ file {}", obj.display()))?;
+    Ok(
+        match std::fs::canonicalize(dir)
+            .ok()
+            .and_then(|d| abs.strip_prefix(d).ok().map(Path::to_path_buf))
+        {
+            Some(rel) => rel.display().to_string(),
+            None => abs.display().to_string(),
+        },
+    )
 }
 
 /// The prototypes of an inventory, the prototype of each item, and the `auto:` kind's
@@ -233,7 +225,7 @@ fn prototypes(dir: &Path, inv: &Inventory) -> Result<Prototypes> {
 }
 
 pub(super) fn run(opts: &Options) -> Result<()> {
-    let bytes = std::fs::read(&opts.target)
+    let bytes = crate::scene::read_input(&opts.target)
         .with_context(|| format!("cannot read --target {}", opts.target.display()))?;
     let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
         .with_context(|| format!("--target {} is not a readable PNG", opts.target.display()))?;
@@ -287,8 +279,9 @@ pub(super) fn run(opts: &Options) -> Result<()> {
                                      "position": [0.0, 0.0, 1.0], "density": 1000.0}]);
     }
     write(&probe_file, &probe)?;
-    let scene = load::scene(&probe_file).map_err(|e| in_users_terms(e, &opts.target, &protos))?;
+    let scene = load_probe(&probe_file, &probe, &protos, &opts.target, &write)?;
     check_sizes(&scene, &protos)?;
+    check_dark_part(&scene, &protos, &opts.target)?;
     let objects: Vec<Object> = protos
         .iter()
         .zip(&scene.occluders)
@@ -427,7 +420,8 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         ..
     }) = best
     else {
-        return Err(first_error.expect("every setting gave a design or an error"));
+        let err = first_error.expect("every setting gave a design or an error");
+        return Err(design_in_users_terms(err, opts, &scene, &protos, &of_item));
     };
     // The folder's scene is replaced only now, target first: a scene.json is never left
     // beside a target it was not made for.
@@ -461,10 +455,16 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let n = plan.objects.len();
     let heights: Vec<f64> = (0..n).map(|k| plan.height(k)).collect();
     let chosen = n - opts.inventory.items.len();
+    // The scene's contacts mode, as written (bsa new writes the default, a constraint).
+    let contact_rule = match problem.scene.contacts {
+        Contacts::Constraint => "the solver ranks launches without one first",
+        Contacts::Penalty => "the solver treats it as a penalty",
+    };
     println!(
-        "{}: {} objects{}; heights at t {:.2} to {:.2} m; {} move{} to keep the flights apart; start guess IoU {:.4}, {}; wrote {}/{{scene.json, target.png, start.png}}; next: bsa solve {}",
+        "{}: {} object{}{}; heights at t {:.2} to {:.2} m; {} move{} to keep the flights apart; start guess IoU {:.4}, {}; wrote {}/{{scene.json, target.png, start.png}}; next: bsa solve {}",
         name,
         n,
+        if n == 1 { "" } else { "s" },
         if opts.inventory.auto.is_some() { format!(" ({chosen} chosen by auto:)") } else { String::new() },
         heights.iter().copied().fold(f64::INFINITY, f64::min),
         heights.iter().copied().fold(0.0, f64::max),
@@ -472,7 +472,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         if moves == 1 { "" } else { "s" },
         start.iou,
         if start.outcome.n_contacts > 0 {
-            format!("with a contact at {:.3} s (the solver treats it as a penalty)", start.outcome.t_sim)
+            format!("with a contact at {:.3} s ({contact_rule})", start.outcome.t_sim)
         } else {
             "no contact before t".to_string()
         },
@@ -660,7 +660,6 @@ fn trial_solve(plan: &Plan, file: &Path, name: &str, seed: u64) -> Result<Solved
 /// An error of the first scene, which is a scratch file the user never wrote, told in
 /// terms of the command's own inputs: `--target`, or the `--objects` item at fault.
 fn in_users_terms(err: anyhow::Error, target: &Path, protos: &[Prototype]) -> anyhow::Error {
-    use crate::scene::SceneError;
     let target = target.display();
     // `occluders[k]...` of the first scene is the k-th distinct object of the list.
     let object = |field: &str| -> Option<String> {
@@ -691,6 +690,161 @@ fn in_users_terms(err: anyhow::Error, target: &Path, protos: &[Prototype]) -> an
     }
 }
 
+/// Load the first scene ([`probe_json`]), telling its errors in the user's terms.
+///
+/// Its objects stand 10 m apart from 100 m above its table, so one some tens of metres
+/// across overlaps another or the table: an overlap in a scratch file the user never
+/// wrote, which says nothing of what is wrong. Then each object is loaded again alone,
+/// with no table (one body overlaps nothing), so that its size is known and
+/// [`check_sizes`] can say what is wrong with it.
+fn load_probe(
+    file: &Path,
+    probe: &Value,
+    protos: &[Prototype],
+    target: &Path,
+    write: &dyn Fn(&Path, &Value) -> Result<()>,
+) -> Result<Scene> {
+    let err = match load::scene(file) {
+        Ok(scene) => return Ok(scene),
+        Err(e) => e,
+    };
+    if !matches!(
+        err.downcast_ref::<SceneError>(),
+        Some(SceneError::Overlap { .. })
+    ) {
+        return Err(in_users_terms(err, target, protos));
+    }
+    let mut first: Option<Scene> = None;
+    let mut occluders = Vec::with_capacity(protos.len());
+    for (k, p) in protos.iter().enumerate() {
+        let mut alone = probe.clone();
+        alone["occluders"] = json!([probe["occluders"][k].clone()]);
+        alone["strategy"] = default_strategy(1);
+        if let Some(o) = alone.as_object_mut() {
+            o.remove("table");
+        }
+        write(file, &alone)?;
+        let scene =
+            load::scene(file).map_err(|e| in_users_terms(e, target, std::slice::from_ref(p)))?;
+        occluders.extend(scene.occluders.iter().cloned());
+        first.get_or_insert(scene);
+    }
+    let mut scene = first.ok_or(err)?;
+    // The designs take the objects' shapes from this scene, and the table's top from
+    // it: none here, so the receiver's plane, where the first scene's table had it.
+    scene.occluders = occluders;
+    Ok(scene)
+}
+
+/// A length or area for a message: three decimals at everyday sizes, a power of ten
+/// beyond them (a mesh of +-5e5 m is 1732050.808 m across otherwise, and a shadow of
+/// 0.0013 m^2 would read 0.001).
+fn amount(x: f64) -> String {
+    if (0.1..1e4).contains(&x) {
+        format!("{x:.3}")
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
+/// A picture whose dark part is much smaller than any shadow the objects can cast
+/// cannot be drawn by them ([`design::check_dark_part`]): refused before any design,
+/// rather than designed and solved (a minute on an 8000 x 8000 picture) to IoU 0.
+fn check_dark_part(scene: &Scene, protos: &[Prototype], target: &Path) -> Result<()> {
+    let pixel = scene.receiver.width / scene.target.width() as f64;
+    // The first scene holds one occluder per prototype, in order (a placeholder sphere
+    // when there is none: `auto:sphere` alone, whose radii are chosen to fit).
+    let least: Vec<f64> = scene
+        .occluders
+        .iter()
+        .zip(protos)
+        .map(|(o, _)| design::least_shadow_area(&o.shape, o.bounding_radius))
+        .collect();
+    match design::check_dark_part(scene.target.count(), pixel * pixel, &least) {
+        Ok(()) => Ok(()),
+        Err(DesignError::TooLittleDark {
+            dark_pixels,
+            dark_area,
+            object,
+            least_shadow,
+        }) => {
+            let width = scene.receiver.width;
+            // The dark part's area grows with the square of the picture's width.
+            let wider = width * (design::LEAST_DARK_SHARE * least_shadow / dark_area).sqrt();
+            bail!(
+                "--target {}: its dark part ({dark_pixels} pixel{} of {} x {}, {} m^2 at --width {width}) is less than half the least shadow that --objects {} can cast ({} m^2, {:.0} pixels, at any height and turn), so no launch can draw it: use a wider picture (--width {} or more), or smaller objects",
+                target.display(),
+                if dark_pixels == 1 { "" } else { "s" },
+                scene.target.width(),
+                scene.target.height(),
+                amount(dark_area),
+                protos[object].describe(),
+                amount(least_shadow),
+                least_shadow / (pixel * pixel),
+                amount(wider),
+            )
+        }
+        Err(e) => Err(e.into()),
+    }
+}
+
+/// An `auto:` item as the user's list names it.
+fn describe_auto(auto: &Auto) -> String {
+    match &auto.kind {
+        AutoKind::Sphere { radius: None } => "auto:sphere".to_string(),
+        AutoKind::Sphere { radius: Some(r) } => format!("auto:sphere:{r}"),
+        AutoKind::Box { size } => format!("auto:box:{}x{}x{}", size[0], size[1], size[2]),
+        AutoKind::Mesh { obj, scale } if *scale != 1.0 => {
+            format!("auto:mesh:{}@{scale}", obj.display())
+        }
+        AutoKind::Mesh { obj, .. } => format!("auto:mesh:{}", obj.display()),
+        AutoKind::Chess => "auto:chess".to_string(),
+    }
+}
+
+/// A design's error told in terms of the command's inputs: which `--objects` item, on
+/// which `--target`, and what to change.
+fn design_in_users_terms(
+    err: anyhow::Error,
+    opts: &Options,
+    scene: &Scene,
+    protos: &[Prototype],
+    of_item: &[usize],
+) -> anyhow::Error {
+    let target = opts.target.display();
+    let picture = format!(
+        "--target {target} ({} dark pixels of {} x {}, {} m wide)",
+        scene.target.count(),
+        scene.target.width(),
+        scene.target.height(),
+        scene.receiver.width
+    );
+    match err.downcast_ref::<DesignError>() {
+        Some(DesignError::NothingWorthIt) => {
+            let auto = opts
+                .inventory
+                .auto
+                .as_ref()
+                .map_or("auto:".to_string(), describe_auto);
+            anyhow::anyhow!(
+                "--objects {auto}: on {picture} no such object is worth launching: wherever its shadow falls it would cover less than {:.0} % of its own area with dark pixels not yet covered; use smaller objects (auto:sphere chooses their size), or a wider picture (--width) so that the picture's strokes are wider against them",
+                design::AUTO_MIN_SHARE * 100.0
+            )
+        }
+        Some(DesignError::NoRoom { index, .. }) => {
+            // The design's objects are the list's fixed items, in order.
+            let what = of_item
+                .get(index - 1)
+                .and_then(|&k| protos.get(k))
+                .map_or_else(|| format!("object {index}"), Prototype::describe);
+            anyhow::anyhow!(
+                "--objects: no room for {what} (object {index}) on {picture}: every place on the picture needs a height that another shadow there already takes; use fewer or smaller objects, or a wider picture (--width)"
+            )
+        }
+        _ => err,
+    }
+}
+
 /// An object whose shadow is wider than the picture cannot be part of it; one whose
 /// shadow is smaller than a pixel even at the highest ceiling cannot be seen in it.
 fn check_sizes(scene: &Scene, protos: &[Prototype]) -> Result<()> {
@@ -713,10 +867,10 @@ fn check_sizes(scene: &Scene, protos: &[Prototype]) -> Result<()> {
         let shadow = 2.0 * o.bounding_radius * 1.5;
         if shadow > scene.receiver.width.min(scene.receiver.height) {
             bail!(
-                "--objects: {} ({:.3} m across) casts a shadow of about {:.2} m, larger than the {:.2} x {:.2} m picture: use a wider picture (--width) or smaller objects",
+                "--objects: {} ({} m across) casts a shadow of about {} m, larger than the {:.2} x {:.2} m picture, so it cannot be part of it: use a wider picture (--width) or smaller objects",
                 p.describe(),
-                2.0 * o.bounding_radius,
-                shadow,
+                amount(2.0 * o.bounding_radius),
+                amount(shadow),
                 scene.receiver.width,
                 scene.receiver.height
             );

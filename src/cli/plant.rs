@@ -79,7 +79,7 @@ impl Design {
 fn read_inventory(arg: &str) -> Result<Inventory> {
     if arg.to_ascii_lowercase().ends_with(".json") {
         let path = std::path::Path::new(arg);
-        let text = std::fs::read_to_string(path)
+        let text = crate::scene::read_input_text(path)
             .with_context(|| format!("--objects: cannot read {}", path.display()))?;
         let base = path.parent().unwrap_or(std::path::Path::new("."));
         return inventory::parse_json(&text, base)
@@ -146,9 +146,10 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         &mut ws,
     );
     println!(
-        "{}: {} objects, target {} shadow pixels; the planted launch (IoU 1) is in {}; start guess IoU {:.4}; wrote {}/{{scene.json, target.png, planted.json}}",
+        "{}: {} object{}, target {} shadow pixels; the planted launch (IoU 1) is in {}; start guess IoU {:.4}; wrote {}/{{scene.json, target.png, planted.json}}",
         name,
         layout.len(),
+        if layout.len() == 1 { "" } else { "s" },
         target.count(),
         dir.join("planted.json").display(),
         start.iou,

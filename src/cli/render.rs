@@ -50,7 +50,21 @@ impl Options {
 
 pub(super) fn run(opts: &Options) -> Result<()> {
     let mut scene = load::scene(&opts.scene)?;
+    let before: Vec<_> = scene.occluders.iter().map(|o| o.launch_com()).collect();
     let launch = launches::read_launches(&opts.solution, &mut scene)?;
+    // A launch file may carry other launch positions (a solve with free positions, or
+    // a builder's edit of launch.csv): say so, the picture depends on it.
+    for (o, was) in scene.occluders.iter().zip(&before) {
+        let moved = o.launch_com().distance(*was);
+        if moved > 1e-9 {
+            eprintln!(
+                "note: {} launches `{}` from {:?} (its centre of mass), {moved:.4} m from the scene's position",
+                opts.solution.display(),
+                o.name,
+                o.launch_com().to_array().map(|x| (x * 1e6).round() / 1e6)
+            );
+        }
+    }
     let params = launch.params;
     let mut problem = Problem::new(scene);
     if let Some(air) = launch.air.or(opts.air.then(DragConfig::default)) {

@@ -5,7 +5,9 @@
 //! the design choose the count: `auto:sphere` (radii chosen too), `auto:sphere:R`,
 //! `auto:box:XxYxZ`, `auto:mesh:FILE.obj[@SCALE]`, `auto:chess` (pieces of one side).
 //! [`parse_json`] reads the same from a JSON file. Errors name the item (or the
-//! JSON entry and field) and say why.
+//! JSON entry and field) and say why. A mesh's file must exist when the list is read:
+//! its path is taken as given (relative to the current folder, or to a JSON list's
+//! folder) and nowhere else, so that the error names the path the user wrote.
 
 use std::path::{Path, PathBuf};
 
@@ -86,6 +88,9 @@ pub enum InventoryError {
     /// The list is empty.
     #[error("the object list is empty (e.g. `box:0.14x0.07x0.035*6,sphere:0.1`)")]
     Empty,
+    /// An item of a non-empty list is empty: two commas in a row, or one at an end.
+    #[error("object list item {index} is empty (two commas in a row, or a comma at an end): remove the comma or put an object there")]
+    EmptyItem { index: usize },
     /// An item names no known kind.
     #[error("object list item {index} `{item}`: unknown kind `{kind}` (sphere:R, box:XxYxZ, mesh:FILE.obj[@SCALE], chess:PIECE, chess, auto:...)")]
     Kind {
@@ -100,7 +105,8 @@ pub enum InventoryError {
         item: String,
         reason: String,
     },
-    /// A JSON object list is malformed.
+    /// A JSON object list is malformed, or has a key it does not know (at the top level
+    /// or in an entry).
     #[error("{field}: {reason}")]
     Json { field: String, reason: String },
     /// More objects than [`MAX_OBJECTS`].
@@ -125,6 +131,9 @@ struct Spec {
     radius: Option<f64>,
     size: Option<[f64; 3]>,
     obj: Option<PathBuf>,
+    /// The folder a JSON list's mesh paths are relative to (`None` on the command
+    /// line, where they are relative to the current folder).
+    obj_base: Option<PathBuf>,
     scale: Option<f64>,
     piece: Option<String>,
     auto: bool,
@@ -185,7 +194,10 @@ fn add(
     };
     let mesh = || -> Result<PathBuf, (String, String)> {
         match &spec.obj {
-            Some(p) if !p.as_os_str().is_empty() => Ok(p.clone()),
+            Some(p) if !p.as_os_str().is_empty() => {
+                mesh_file(p, spec.obj_base.as_deref()).map_err(|r| bad("obj", r))?;
+                Ok(p.clone())
+            }
             _ => Err(bad("obj", "mesh needs an OBJ file".into())),
         }
     };
@@ -278,7 +290,11 @@ fn add(
         },
         other => return Err(bad("kind", format!("unknown kind `{other}`"))),
     };
-    let total = inv.items.len() + n * kinds.len();
+    // Saturating: a JSON count near 2^64 must not wrap round to a small total.
+    let total = inv
+        .items
+        .len()
+        .saturating_add(n.saturating_mul(kinds.len()));
     if total > MAX_OBJECTS {
         return Err(bad(
             "count",
@@ -294,18 +310,64 @@ fn add(
     Ok(())
 }
 
+/// Check that a mesh's OBJ file is there, at `path` as the list gives it (joined to
+/// `base`, a JSON list's folder): the scene that `bsa new` writes elsewhere must not
+/// find another file of that name relative to its own folder. The reason names the
+/// path and what it is relative to. The file's contents are checked when it is loaded.
+fn mesh_file(path: &Path, base: Option<&Path>) -> Result<(), String> {
+    let relative_to = match base {
+        Some(b) if path.is_relative() || path.starts_with(b) => {
+            " (a JSON list's mesh paths are relative to the list's folder)"
+        }
+        Some(_) => "",
+        None if path.is_relative() => " (mesh paths are relative to the current folder)",
+        None => "",
+    };
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => Err(format!(
+            "{} is a folder, not an OBJ file{relative_to}",
+            path.display()
+        )),
+        Ok(_) => Ok(()),
+        Err(e) => Err(format!(
+            "cannot read the OBJ file {}: {e}{relative_to}",
+            path.display()
+        )),
+    }
+}
+
+/// The reason a count that is not a `usize` is refused: a whole number beyond the
+/// largest list is too large, not malformed.
+fn bad_count(n: &str) -> String {
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    let n = n.trim();
+    match n.strip_prefix('-') {
+        Some(d) if digits(d) => format!("count must be at least 1, got {n}"),
+        _ if digits(n.strip_prefix('+').unwrap_or(n)) => {
+            format!("count {n} is more than the {MAX_OBJECTS} objects a list may hold")
+        }
+        _ => format!("count `{n}` is not a whole number"),
+    }
+}
+
 /// Parse a comma-separated object list.
 pub fn parse(list: &str) -> Result<Inventory, InventoryError> {
     let mut inv = Inventory {
         items: Vec::new(),
         auto: None,
     };
+    if list.trim().is_empty() {
+        return Err(InventoryError::Empty);
+    }
     let mut auto_at = None;
     for (k, raw) in list.split(',').map(str::trim).enumerate() {
-        if raw.is_empty() {
-            continue;
-        }
         let index = k + 1;
+        // An empty item is most likely a slip (an object deleted from the middle of
+        // the list, or left out): reading the list without it could design a scene
+        // with fewer objects than the user meant.
+        if raw.is_empty() {
+            return Err(InventoryError::EmptyItem { index });
+        }
         let bad = |reason: String| InventoryError::Item {
             index,
             item: raw.to_string(),
@@ -324,10 +386,7 @@ pub fn parse(list: &str) -> Result<Inventory, InventoryError> {
         };
         let (spec_text, count) = match body.rsplit_once('*') {
             Some((s, n)) => {
-                let n: usize = n
-                    .trim()
-                    .parse()
-                    .map_err(|_| bad(format!("count `{n}` is not a whole number")))?;
+                let n: usize = n.trim().parse().map_err(|_| bad(bad_count(n)))?;
                 (s, Some(n))
             }
             None => (body, None),
@@ -399,15 +458,26 @@ pub fn parse_json(text: &str, base: &Path) -> Result<Inventory, InventoryError> 
         .map_err(|e| json("objects".into(), format!("not valid JSON: {e}")))?;
     let list = match &v {
         Value::Array(a) => a.clone(),
-        Value::Object(o) => match o.get("objects") {
-            Some(Value::Array(a)) => a.clone(),
-            _ => {
+        Value::Object(o) => {
+            // As in an entry, a key the list does not know is refused rather than
+            // ignored: it is a misspelling or a setting that would have no effect.
+            if let Some(key) = o.keys().find(|k| k.as_str() != "objects") {
                 return Err(json(
-                    "objects".into(),
-                    "expected an array of objects, or {\"objects\": [...]}".into(),
-                ))
+                    key.clone(),
+                    "unknown key (the file holds an array, or {\"objects\": [...]} and nothing else)"
+                        .into(),
+                ));
             }
-        },
+            match o.get("objects") {
+                Some(Value::Array(a)) => a.clone(),
+                _ => {
+                    return Err(json(
+                        "objects".into(),
+                        "expected an array of objects, or {\"objects\": [...]}".into(),
+                    ))
+                }
+            }
+        }
         _ => {
             return Err(json(
                 "objects".into(),
@@ -470,9 +540,23 @@ pub fn parse_json(text: &str, base: &Path) -> Result<Inventory, InventoryError> 
         let (auto, count) = match o.get("count") {
             None => (false, None),
             Some(Value::String(s)) if s == "auto" => (true, None),
-            Some(x) => match x.as_u64() {
-                Some(n) => (false, Some(n as usize)),
-                None => {
+            Some(x) => match (x.as_u64(), x.as_f64()) {
+                (Some(n), _) => (false, Some(usize::try_from(n).unwrap_or(usize::MAX))),
+                // A whole number beyond u64 (read as a float) is too large, not
+                // malformed; a negative one is below the least count.
+                (None, Some(f)) if f.fract() == 0.0 && f > 0.0 => {
+                    return Err(json(
+                        at("count"),
+                        format!("count {f} is more than the {MAX_OBJECTS} objects a list may hold"),
+                    ))
+                }
+                (None, Some(f)) if f.fract() == 0.0 => {
+                    return Err(json(
+                        at("count"),
+                        format!("count must be at least 1, got {x}"),
+                    ))
+                }
+                _ => {
                     return Err(json(
                         at("count"),
                         format!("expected a whole number or \"auto\", got {x}"),
@@ -485,6 +569,7 @@ pub fn parse_json(text: &str, base: &Path) -> Result<Inventory, InventoryError> 
             radius: num("radius")?,
             size,
             obj: text_of("obj")?.map(|p| base.join(p)),
+            obj_base: Some(base.to_path_buf()),
             scale: num("scale")?,
             piece: text_of("piece")?,
             auto,
@@ -505,7 +590,9 @@ mod tests {
 
     #[test]
     fn counts_densities_and_scales_are_read() {
-        let inv = parse("box:0.14x0.07x0.035*2/600, sphere:0.1, mesh:pieces/pawn.obj@2*3").unwrap();
+        let inv =
+            parse("box:0.14x0.07x0.035*2/600, sphere:0.1, mesh:scenes/thinker/pieces/pawn.obj@2*3")
+                .unwrap();
         let items = inv.items;
         assert_eq!(items.len(), 6);
         assert_eq!(
@@ -522,7 +609,7 @@ mod tests {
         assert_eq!(
             items[5].kind,
             Kind::Mesh {
-                obj: "pieces/pawn.obj".into(),
+                obj: "scenes/thinker/pieces/pawn.obj".into(),
                 scale: 2.0
             }
         );
@@ -576,7 +663,7 @@ mod tests {
             {"kind": "box", "size": [0.14, 0.07, 0.035], "count": 2, "density": 600},
             {"kind": "mesh", "obj": "pawn.obj", "scale": 2},
             {"kind": "sphere", "count": "auto"}]}"#;
-        let inv = parse_json(text, Path::new("/in")).unwrap();
+        let inv = parse_json(text, Path::new("scenes/thinker/pieces")).unwrap();
         assert_eq!(inv.items.len(), 3);
         assert_eq!(
             inv.items[0],
@@ -585,7 +672,7 @@ mod tests {
         assert_eq!(
             inv.items[2].kind,
             Kind::Mesh {
-                obj: "/in/pawn.obj".into(),
+                obj: "scenes/thinker/pieces/pawn.obj".into(),
                 scale: 2.0
             }
         );
@@ -606,6 +693,19 @@ mod tests {
             ("auto:box:0.1x0.1x0.1*3", "drop *N"),
             ("auto:sphere,auto:chess", "at most one auto"),
             ("sphere", "expected kind:size"),
+            ("sphere:0.1,,sphere:0.1", "item 2 is empty"),
+            ("sphere:0.1,", "item 2 is empty"),
+            (
+                "sphere:0.1*1000000000000000000000000000000",
+                "more than the 64 objects",
+            ),
+            ("sphere:0.1*-2", "at least 1, got -2"),
+            ("sphere:0.1*2.5", "`2.5` is not a whole number"),
+            (
+                "mesh:no/such/file.obj",
+                "cannot read the OBJ file no/such/file.obj",
+            ),
+            ("mesh:scenes", "scenes is a folder"),
         ] {
             let e = parse(list).unwrap_err().to_string();
             assert!(e.contains(expect), "{list}: {e}");
@@ -628,7 +728,24 @@ mod tests {
                 "[{\"kind\": \"box\", \"size\": [1, 1, 1], \"count\": \"many\"}]",
                 "objects[0].count",
             ),
-            ("{\"things\": []}", "objects: expected an array"),
+            ("{\"things\": []}", "things: unknown key"),
+            ("{\"objects\": 1}", "objects: expected an array"),
+            (
+                "{\"objects\": [{\"kind\": \"sphere\", \"radius\": 0.1}], \"extra\": 1}",
+                "extra: unknown key",
+            ),
+            (
+                "[{\"kind\": \"sphere\", \"radius\": 0.1, \"count\": 99999999999999999999}]",
+                "objects[0].count: count 100000000000000000000 is more than the 64",
+            ),
+            (
+                "[{\"kind\": \"chess\", \"count\": 1152921504606846976}]",
+                "at most 64",
+            ),
+            (
+                "[{\"kind\": \"mesh\", \"obj\": \"nosuch.obj\"}]",
+                "objects[0].obj: cannot read the OBJ file ./nosuch.obj",
+            ),
             ("[1", "not valid JSON"),
         ] {
             let e = parse_json(text, Path::new(".")).unwrap_err().to_string();

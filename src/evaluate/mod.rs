@@ -38,9 +38,7 @@ use crate::sim::flight::{FlightConfig, FreeFlight};
 pub mod instants;
 pub use instants::{FrameIou, Instant, Physics, Plan, Robust, REFERENCE_DRAW};
 
-/// Largest total rotation (rad) of a launched body by `t` that a sample may ask for; more
-/// (over 300 turns) is treated as a diverged sample.
-pub const MAX_TURN: f64 = 2000.0;
+pub use crate::scene::MAX_TURN;
 
 /// The phases [`Problem::profile`] times, in the order a sample runs them.
 pub const PROFILE_PHASES: [&str; 11] = [

@@ -167,7 +167,7 @@ pub fn write_solution(dir: &Path, s: &Solution) -> Result<()> {
 
 /// Read a solution file.
 pub fn read_solution(path: &Path) -> Result<Solution> {
-    let text = std::fs::read_to_string(path).map_err(|source| ExportError::Read {
+    let text = crate::scene::read_input_text(path).map_err(|source| ExportError::Read {
         path: path.to_path_buf(),
         source,
     })?;

@@ -90,8 +90,17 @@ pub enum LaunchFileError {
         field: String,
         value: String,
     },
+    /// A launch beyond the limits of the scene files
+    /// ([`Scene::launch_beyond_limits`]): too fast, or spinning its body too many turns.
+    #[error("{path}: {place}: `{field}` {message}")]
+    TooFast {
+        path: PathBuf,
+        place: String,
+        field: &'static str,
+        message: String,
+    },
     /// A `solution.json` made for another scene.
-    #[error("{path} does not belong to the scene")]
+    #[error("{path} cannot be used with this scene")]
     Mismatch {
         path: PathBuf,
         #[source]
@@ -115,7 +124,7 @@ struct Entry {
 /// solution's fields, else as a minimal launch file. The scene's bodies are moved to the
 /// file's launch positions where it gives others (free positions).
 pub fn read_launches(path: &Path, scene: &mut Scene) -> Result<Launches> {
-    let text = std::fs::read_to_string(path).map_err(|source| LaunchFileError::Io {
+    let text = crate::scene::read_input_text(path).map_err(|source| LaunchFileError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -284,6 +293,14 @@ fn assemble(
             angular_velocity: DVec3::from_array(w),
         }
         .set(&mut params, i);
+        if let Some((field, message)) = scene.launch_beyond_limits(i, &Launch::get(&params, i)) {
+            return Err(LaunchFileError::TooFast {
+                path: path.to_path_buf(),
+                place,
+                field,
+                message,
+            });
+        }
     }
     if let Some(o) = scene
         .occluders

@@ -8,10 +8,11 @@
 //! `video`, `budget` and `--resume` check a loaded one with [`check_solution`] (or
 //! [`check_resumable`]) before using it.
 
+use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use crate::energy::TERM_COUNT;
-use crate::scene::Scene;
+use crate::scene::{Launch, Scene};
 use crate::sim::drag::DragConfig;
 use crate::sim::launch_error::Tolerances;
 
@@ -180,6 +181,13 @@ pub enum MismatchError {
     Time { expected: f64, found: f64 },
     #[error("the solution holds a non-finite launch value for `{name}`")]
     NotFinite { name: String },
+    /// A launch beyond the limits of the scene files ([`Scene::launch_beyond_limits`]).
+    #[error("occluder `{name}`: `{field}` {message}")]
+    TooFast {
+        name: String,
+        field: &'static str,
+        message: String,
+    },
 }
 
 /// Check that a solution was made for this scene: the scene's name, the occluders'
@@ -213,6 +221,17 @@ pub fn check_solution(scene: &Scene, s: &Solution) -> Result<(), MismatchError> 
         {
             return Err(MismatchError::NotFinite {
                 name: b.name.clone(),
+            });
+        }
+        let launch = Launch {
+            velocity: DVec3::from_array(b.velocity),
+            angular_velocity: DVec3::from_array(b.angular_velocity),
+        };
+        if let Some((field, message)) = scene.launch_beyond_limits(i, &launch) {
+            return Err(MismatchError::TooFast {
+                name: b.name.clone(),
+                field,
+                message,
             });
         }
     }

@@ -5,7 +5,7 @@
 use glam::DVec3;
 
 use super::validate::Validator;
-use super::{Result, MAX_COORDINATE};
+use super::{Result, MAX_COORDINATE, MAX_T, MIN_T};
 
 impl Validator<'_> {
     pub(super) fn finite(&self, field: &str, x: f64) -> Result<f64> {
@@ -46,6 +46,18 @@ impl Validator<'_> {
                 format!("must be at most {}, got {}", short(limit), short(x)),
             ))
         }
+    }
+
+    /// A picture's instant (s): from [`MIN_T`] to [`MAX_T`].
+    pub(super) fn instant(&self, field: &str, t: f64) -> Result<f64> {
+        let t = self.positive_within(field, t, MAX_T)?;
+        if t < MIN_T {
+            return Err(self.field_err(
+                field,
+                format!("must be at least {MIN_T} s, got {} s", short(t)),
+            ));
+        }
+        Ok(t)
     }
 
     pub(super) fn positive(&self, field: &str, x: f64) -> Result<f64> {
@@ -98,10 +110,10 @@ impl Validator<'_> {
     }
 }
 
-/// A number as people write limits: plain up to 1e5 (3600, 0.5), in exponent form above
-/// (1e6, 1e300).
-fn short(x: f64) -> String {
-    if x.abs() < 1e5 {
+/// A number as people write limits: plain from 1e-4 up to 1e5 (3600, 0.5), in exponent
+/// form beyond (1e6, 1e300, 1e-300).
+pub(super) fn short(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e5).contains(&x.abs()) {
         format!("{x}")
     } else {
         format!("{x:e}")

@@ -85,6 +85,7 @@ mod validate;
 pub use launch::Launch;
 use raw::RawScene;
 pub use start::auto_order;
+pub use validate::too_fast_spin;
 use validate::Validator;
 
 // ---------------------------------------------------------------------------------
@@ -339,6 +340,43 @@ impl Scene {
         self.t + self.hold.as_ref().map_or(0.0, |h| h.window)
     }
 
+    /// Why occluder `i`'s launch is beyond the limits of the scene files, as the field
+    /// at fault (`velocity` or `angular_velocity`) and the reason: a speed above
+    /// [`MAX_SPEED`], or a spin that turns a launched body more than [`MAX_TURN`] by the
+    /// horizon (the solver's model does not fly it, and its shadow would be missing).
+    pub fn launch_beyond_limits(
+        &self,
+        i: usize,
+        launch: &Launch,
+    ) -> Option<(&'static str, String)> {
+        if !self.occluders[i].launched {
+            return None;
+        }
+        let (v, w) = (launch.velocity, launch.angular_velocity);
+        let speed = v.length();
+        if speed.is_nan() || speed > MAX_SPEED {
+            let speed = if speed.is_finite() {
+                speed
+            } else {
+                v.abs().max_element()
+            };
+            return Some((
+                "velocity",
+                format!("has magnitude {speed:e} m/s, more than the {MAX_SPEED:e} allowed"),
+            ));
+        }
+        let spin = w.length();
+        if spin.is_nan() || spin * self.horizon() > MAX_TURN {
+            let spin = if spin.is_finite() {
+                spin
+            } else {
+                w.abs().max_element()
+            };
+            return Some(("angular_velocity", too_fast_spin(spin, self.horizon())));
+        }
+        None
+    }
+
     /// Whether the scene asks for one shadow at `t` only (one picture, no hold).
     pub fn single_instant(&self) -> bool {
         self.pictures.len() == 1 && self.hold.is_none()
@@ -352,23 +390,38 @@ pub const RESERVED_NAMES: [&str; 5] =
 
 /// Largest target image side (pixels).
 pub const MAX_IMAGE_SIDE: usize = 16384;
-/// Largest CMA-ES population a stage may ask for.
-pub const MAX_POPULATION: usize = 100_000;
+/// Largest CMA-ES population a stage may ask for: more gains CMA-ES nothing on the few
+/// hundred parameters a scene has, and every sample is a row of `convergence.csv`.
+pub const MAX_POPULATION: usize = 10_000;
 
 /// Largest magnitude (m) of any coordinate or length in a scene: positions, the light,
 /// the receiver, the table, hint points, shape sizes and mesh vertices after scaling.
 /// Products of these (squared distances, volumes, moments of inertia) then stay far
 /// from overflow, and no real launch needs more than a thousand kilometres.
 pub const MAX_COORDINATE: f64 = 1e6;
-/// Longest flight time `t` (s): one hour.
-pub const MAX_T: f64 = 3600.0;
+/// Longest flight time `t` (s), and longest hold window: a minute. (A launch that
+/// reaches its picture after a minute has risen 4.4 km, at 300 m/s; a longer one needs
+/// more than [`MAX_SPEED`] or never comes down in the solver's model.)
+pub const MAX_T: f64 = 60.0;
+/// Shortest flight time `t` (s): a hundredth of a second, a frame of a fast camera.
+pub const MIN_T: f64 = 0.01;
 /// Most timesteps (keys) from launch to `t`, `t / timestep`; the trajectory, the
 /// animated export and the continuation store one pose per key and body.
 pub const MAX_KEYS: f64 = 1_000_000.0;
 /// Largest gravity magnitude (m/s^2), a hundred times the Earth's.
 pub const MAX_GRAVITY: f64 = 1000.0;
-/// Largest start speed (m/s) and start angular speed (rad/s) of any occluder.
+/// Largest start speed (m/s) and start angular speed (rad/s) of any occluder, and
+/// largest launch speed of a launch file.
 pub const MAX_SPEED: f64 = 1e4;
+/// Largest total rotation (rad) of a launched body by the horizon (`t`, or the end of
+/// the hold window) that a launch may ask for (over 300 turns): no real launch does, and
+/// the asymmetric-body integrator's step grid grows with the turn. The solver treats a
+/// sample beyond it as diverged; a start guess or a launch file beyond it is refused.
+pub const MAX_TURN: f64 = 2000.0;
+/// Largest input file (bytes) read whole: a scene, a target picture, a launch file.
+/// (OBJ files have their own limit, [`MAX_OBJ_BYTES`].) A larger file, or an endless one
+/// such as a device, is refused instead of filling the memory.
+pub const MAX_INPUT_BYTES: u64 = 256 * 1024 * 1024;
 /// Largest mass (kg) and density (kg/m^3) of an occluder.
 pub const MAX_MASS: f64 = 1e9;
 /// Largest hint pixel coordinate magnitude and largest weight of any term or hint.
@@ -417,6 +470,29 @@ pub const DEFAULT_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
 /// Default height (m) the start guess lifts every launched body's centre of mass by at `t`.
 pub const DEFAULT_START_RISE: f64 = 1.5;
 
+/// The bytes of an input file, at most [`MAX_INPUT_BYTES`] of them: a longer file (or
+/// an endless one, a device) is an `InvalidData` error that says so.
+pub fn read_input(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(MAX_INPUT_BYTES + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_INPUT_BYTES {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("longer than the {} MiB read at most", MAX_INPUT_BYTES >> 20),
+        ));
+    }
+    Ok(bytes)
+}
+
+/// [`read_input`] as UTF-8 text.
+pub fn read_input_text(path: &Path) -> std::io::Result<String> {
+    String::from_utf8(read_input(path)?)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+}
+
 /// Load and validate a scene. `path` is the scene JSON file or a folder holding `scene.json`.
 pub fn load(path: &Path) -> Result<Scene> {
     let file = if path.is_dir() {
@@ -424,13 +500,27 @@ pub fn load(path: &Path) -> Result<Scene> {
     } else {
         path.to_path_buf()
     };
-    let text = std::fs::read_to_string(&file).map_err(|source| SceneError::Io {
+    let text = read_input_text(&file).map_err(|source| SceneError::Io {
         path: file.clone(),
         source,
     })?;
-    let raw: RawScene = serde_json::from_str(&text).map_err(|e| SceneError::Json {
-        path: file.clone(),
-        message: e.to_string(),
+    // The path of the value at fault (`hints[0].pixel`) leads the message: serde's own
+    // errors give a line and column, and for an untagged or tagged enum only say that
+    // nothing matched.
+    let raw: RawScene = serde_path_to_error::deserialize(&mut serde_json::Deserializer::from_str(
+        &text,
+    ))
+    .map_err(|e| {
+        let at = e.path().to_string();
+        let message = e.into_inner().to_string();
+        SceneError::Json {
+            path: file.clone(),
+            message: if at == "." {
+                message
+            } else {
+                format!("`{at}`: {message}")
+            },
+        }
     })?;
     let dir = file
         .parent()

@@ -35,7 +35,7 @@ impl Validator<'_> {
                     "is required (or give `targets`: a list of {target, t, weight})",
                 )
             })?;
-            let t = self.positive_within("t", t, MAX_T)?;
+            let t = self.instant("t", t)?;
             return Ok(vec![PictureSpec {
                 target: self.target(rel)?,
                 file: self.resolve(rel),
@@ -71,7 +71,7 @@ impl Validator<'_> {
             let t = p.t.ok_or_else(|| {
                 self.field_err(f("t"), "is required: the instant of the picture (s)")
             })?;
-            let t = self.positive_within(&f("t"), t, MAX_T)?;
+            let t = self.instant(&f("t"), t)?;
             if let Some(prev) = out.last() {
                 if t <= prev.t {
                     return Err(self.field_err(

@@ -50,12 +50,51 @@ pub(super) struct RawTable {
     pub(super) size: [f64; 3],
 }
 
+/// A shape: an object with exactly one of `sphere`, `box` and `mesh` (checked through
+/// a JSON value first: serde's message for two of them names neither).
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, rename_all = "snake_case")]
+#[serde(try_from = "serde_json::Value")]
 pub(super) enum RawShape {
     Sphere { radius: f64 },
     Box { size: [f64; 3] },
     Mesh { obj: String, scale: Option<f64> },
+}
+
+/// [`RawShape`] as serde reads it once the value holds one kind.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "snake_case")]
+enum TaggedShape {
+    Sphere { radius: f64 },
+    Box { size: [f64; 3] },
+    Mesh { obj: String, scale: Option<f64> },
+}
+
+impl TryFrom<serde_json::Value> for RawShape {
+    type Error = String;
+
+    fn try_from(value: serde_json::Value) -> Result<Self, String> {
+        if let Some(map) = value.as_object().filter(|m| m.len() > 1) {
+            let keys: Vec<&str> = map.keys().map(String::as_str).collect();
+            return Err(format!(
+                "give one of `sphere`, `box` and `mesh`, got {}",
+                keys.join(" and ")
+            ));
+        }
+        let shape = serde_path_to_error::deserialize(value).map_err(|e| {
+            let at = e.path().to_string();
+            let message = e.into_inner().to_string();
+            if at == "." {
+                message
+            } else {
+                format!("`{at}`: {message}")
+            }
+        })?;
+        Ok(match shape {
+            TaggedShape::Sphere { radius } => RawShape::Sphere { radius },
+            TaggedShape::Box { size } => RawShape::Box { size },
+            TaggedShape::Mesh { obj, scale } => RawShape::Mesh { obj, scale },
+        })
+    }
 }
 
 #[derive(Deserialize)]
@@ -72,11 +111,38 @@ pub(super) struct RawOccluder {
     pub(super) start_angular_velocity: Option<[f64; 3]>,
 }
 
+/// Hints: a file name, or a list of hints. Read through a JSON value so that a wrong
+/// hint's error names its index and field (serde's untagged enums only say that no
+/// variant matched).
 #[derive(Deserialize)]
-#[serde(untagged)]
+#[serde(try_from = "serde_json::Value")]
 pub(super) enum RawHints {
     File(String),
     Inline(Vec<RawHint>),
+}
+
+impl TryFrom<serde_json::Value> for RawHints {
+    type Error = String;
+
+    fn try_from(value: serde_json::Value) -> Result<Self, String> {
+        match value {
+            serde_json::Value::String(file) => Ok(RawHints::File(file)),
+            serde_json::Value::Array(items) => items
+                .into_iter()
+                .enumerate()
+                .map(|(k, item)| {
+                    serde_path_to_error::deserialize(item).map_err(|e| {
+                        let at = e.path().to_string();
+                        format!("hint [{k}], `{at}`: {}", e.into_inner())
+                    })
+                })
+                .collect::<Result<_, _>>()
+                .map(RawHints::Inline),
+            other => Err(format!(
+                "must be a file name or a list of hints ({{\"occluder\", \"point\": [x, y, z], \"pixel\": [x, y], \"weight\"}}), got {other}"
+            )),
+        }
+    }
 }
 
 #[derive(Deserialize)]

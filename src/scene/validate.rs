@@ -64,7 +64,14 @@ impl Validator<'_> {
             ));
         }
         if dt > t {
-            return Err(self.field_err("timestep", format!("must not exceed t = {t} s, got {dt}")));
+            return Err(self.field_err(
+                "timestep",
+                format!(
+                    "must not exceed t = {} s, got {}",
+                    super::bounds::short(t),
+                    super::bounds::short(dt)
+                ),
+            ));
         }
         // Every key from launch to t is stored (trajectory, export, continuation), so
         // their count bounds memory.
@@ -83,6 +90,17 @@ impl Validator<'_> {
             raw.gravity.unwrap_or(DEFAULT_GRAVITY),
             MAX_GRAVITY,
         )?;
+        // The objects are launched upwards from the table's top and come down: every
+        // start guess and design counts on it (z is up).
+        if gravity.z.is_nan() || gravity.z >= 0.0 {
+            return Err(self.field_err(
+                "gravity",
+                format!(
+                    "must pull down (a negative z, z is up), got {:?}",
+                    gravity.to_array()
+                ),
+            ));
+        }
         let light = self.vec3("light", raw.light)?;
         let receiver = self.receiver(&raw.receiver, light)?;
         let target = specs.last().expect("at least one picture").target.clone();
@@ -138,7 +156,7 @@ impl Validator<'_> {
         }
         let mut occluders = Vec::with_capacity(raw.occluders.len());
         for (i, ro) in raw.occluders.iter().enumerate() {
-            let o = self.occluder(i, ro, t, gravity, rise)?;
+            let o = self.occluder(i, ro, (t, horizon), gravity, rise)?;
             if RESERVED_NAMES.contains(&o.name.as_str()) {
                 return Err(self.field_err(
                     format!("occluders[{i}].name"),
@@ -284,7 +302,7 @@ impl Validator<'_> {
 
     pub(super) fn target(&self, rel: &str) -> Result<Mask> {
         let path = self.resolve(rel);
-        let bytes = std::fs::read(&path).map_err(|source| SceneError::Io {
+        let bytes = super::read_input(&path).map_err(|source| SceneError::Io {
             path: path.clone(),
             source,
         })?;
@@ -318,7 +336,7 @@ impl Validator<'_> {
         &self,
         i: usize,
         ro: &RawOccluder,
-        t: f64,
+        (t, horizon): (f64, f64),
         gravity: DVec3,
         rise: f64,
     ) -> Result<Occluder> {
@@ -427,7 +445,14 @@ impl Validator<'_> {
             None => default_v,
         };
         let start_angular_velocity = match ro.start_angular_velocity {
-            Some(w) => self.vec3_len_within(&f("start_angular_velocity"), w, MAX_SPEED)?,
+            Some(w) => {
+                let field = f("start_angular_velocity");
+                let w = self.vec3_len_within(&field, w, MAX_SPEED)?;
+                if launched && w.length() * horizon > MAX_TURN {
+                    return Err(self.field_err(field, too_fast_spin(w.length(), horizon)));
+                }
+                w
+            }
             None => DVec3::ZERO,
         };
         let bounding_radius = shape.bounding_radius(mass.local_com);
@@ -533,7 +558,7 @@ impl Validator<'_> {
     /// Hints in a text file, one per line: `occluder x y z px py [weight]`; `#` starts a
     /// comment. This is the paper's "hints stored separately in a text file".
     pub(super) fn hints_file(&self, path: &Path, occ: &[Occluder]) -> Result<Vec<Hint>> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        let text = super::read_input_text(path).map_err(|source| SceneError::Io {
             path: path.to_path_buf(),
             source,
         })?;
@@ -608,6 +633,12 @@ impl Validator<'_> {
             })?;
             w[term as usize] = self.non_negative(&format!("{field}.weights.{key}"), *value)?;
             self.within(&format!("{field}.weights.{key}"), *value, MAX_WEIGHT)?;
+        }
+        if w.iter().all(|&x| x == 0.0) {
+            return Err(self.field_err(
+                format!("{field}.weights"),
+                "gives every term a weight of 0, so the stage has nothing to optimise; leave `weights` out for the defaults",
+            ));
         }
         let vary = match &rs.vary {
             None => default_vary.to_vec(),
@@ -828,4 +859,14 @@ impl StageDefaults {
             restarts: if last { DEFAULT_RESTARTS } else { 1 },
         }
     }
+}
+
+/// Why a launch's spin is refused: it turns the body more than [`MAX_TURN`] by the
+/// horizon, and the fastest spin that does not.
+pub fn too_fast_spin(spin: f64, horizon: f64) -> String {
+    format!(
+        "turns the body {:.0} rad by {horizon} s, more than the {MAX_TURN} rad (over 300 turns) allowed: at most {:.1} rad/s",
+        spin * horizon,
+        MAX_TURN / horizon
+    )
 }

@@ -365,3 +365,264 @@ fn copied_scene_with_the_original_name_never_touches_the_originals_results() {
     );
     assert!(!results.join("budget.md").exists(), "stale budget kept");
 }
+
+/// A closed OBJ cube of half side `half` (m), centred on the origin.
+fn cube_obj(path: &Path, half: f64) {
+    let mut text = String::new();
+    for z in [-half, half] {
+        for (x, y) in [(-half, -half), (half, -half), (half, half), (-half, half)] {
+            text.push_str(&format!("v {x} {y} {z}\n"));
+        }
+    }
+    text.push_str("f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n");
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    std::fs::write(path, text).unwrap();
+}
+
+/// A `w` x `h` picture, black where `dark` holds, white elsewhere.
+fn picture(path: &Path, w: u32, h: u32, dark: impl Fn(u32, u32) -> bool) {
+    image::GrayImage::from_fn(w, h, |x, y| image::Luma([if dark(x, y) { 0 } else { 255 }]))
+        .save(path)
+        .unwrap();
+}
+
+/// A 64 x 48 picture of a disc of radius 4 pixels: a sphere of 0.1 m on the default
+/// 1.6 m wide picture.
+fn disc(path: &Path) {
+    picture(path, 64, 48, |x, y| {
+        let (dx, dy) = (x as i64 - 32, y as i64 - 24);
+        dx * dx + dy * dy <= 16
+    });
+}
+
+/// `bsa new` in `cwd` (relative paths are the user's): (success, stdout, stderr).
+fn new_in(cwd: &Path, target: &Path, objects: &str, extra: &[&str]) -> (bool, String, String) {
+    let mut args = vec![
+        "new",
+        "out",
+        "--target",
+        target.to_str().unwrap(),
+        "--objects",
+        objects,
+    ];
+    args.extend_from_slice(extra);
+    bsa_in(cwd, &args)
+}
+
+#[test]
+fn new_names_a_missing_mesh_as_typed_and_never_reads_one_beside_the_scene() {
+    // The file is missing where the user's path points (the current folder) but there
+    // is one of that name inside the output folder: before the fix the scene read that
+    // one instead, or an error named `out/obj/...`, a path the user never typed.
+    let d = tmpdir("new-mesh-missing");
+    let target = d.join("disc.png");
+    disc(&target);
+    cube_obj(&d.join("out/obj/cube.obj"), 0.05);
+    let (ok, _, err) = new_in(&d, &target, "mesh:obj/cube.obj", &["--choose-by", "start"]);
+    assert!(!ok, "a mesh was read from beside the scene: {err}");
+    assert!(
+        err.contains("--objects")
+            && err.contains("item 1 `mesh:obj/cube.obj`")
+            && err.contains("cannot read the OBJ file obj/cube.obj")
+            && err.contains("relative to the current folder")
+            && !err.contains("out/obj"),
+        "{err}"
+    );
+    // In a JSON list: the file and the entry, and the path as the list's folder makes it.
+    std::fs::create_dir_all(d.join("lists")).unwrap();
+    std::fs::write(
+        d.join("lists/box.json"),
+        r#"[{"kind": "sphere", "radius": 0.1}, {"kind": "mesh", "obj": "cube.obj"}]"#,
+    )
+    .unwrap();
+    let (ok, _, err) = new_in(&d, &target, "lists/box.json", &[]);
+    assert!(
+        !ok && err.contains("--objects lists/box.json")
+            && err.contains("objects[1].obj")
+            && err.contains("lists/cube.obj")
+            && !err.contains("out/"),
+        "{err}"
+    );
+    // Where it is, the scene names it so that it is found from any folder.
+    cube_obj(&d.join("obj/cube.obj"), 0.05);
+    let (ok, _, err) = new_in(&d, &target, "mesh:obj/cube.obj", &["--choose-by", "start"]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = bsa(&["check", d.join("out").to_str().unwrap()]);
+    assert!(ok, "{err}");
+}
+
+#[test]
+fn new_tells_an_object_too_large_for_the_picture_by_its_item_not_by_a_scratch_file() {
+    // A cube of +-5e5 m overlapped the table of the first (scratch) scene, and the error
+    // named that file and its occluder.
+    let d = tmpdir("new-mesh-huge");
+    let target = d.join("disc.png");
+    disc(&target);
+    cube_obj(&d.join("obj/big.obj"), 5e5);
+    for objects in ["mesh:obj/big.obj", "sphere:0.1,mesh:obj/big.obj"] {
+        let (ok, _, err) = new_in(&d, &target, objects, &[]);
+        assert!(!ok && !err.contains("panicked"), "{objects}: {err}");
+        assert!(
+            err.contains("--objects: mesh:obj/big.obj (1.732e6 m across)")
+                && err.contains("larger than the 1.60 x 1.20 m picture")
+                && !err.contains(".bsa-new")
+                && !err.contains("overlap"),
+            "{objects}: {err}"
+        );
+    }
+}
+
+#[test]
+fn new_refuses_an_empty_item_and_an_unknown_key_of_a_json_list() {
+    let d = tmpdir("new-empty-item");
+    let target = d.join("disc.png");
+    disc(&target);
+    let (ok, _, err) = new_in(&d, &target, "sphere:0.1,,sphere:0.1", &[]);
+    assert!(
+        !ok && err.contains("--objects") && err.contains("item 2 is empty"),
+        "{err}"
+    );
+    std::fs::write(
+        d.join("list.json"),
+        r#"{"objects": [{"kind": "sphere", "radius": 0.1}], "extra": 1}"#,
+    )
+    .unwrap();
+    let (ok, _, err) = new_in(&d, &target, "list.json", &[]);
+    assert!(
+        !ok && err.contains("--objects list.json") && err.contains("extra: unknown key"),
+        "{err}"
+    );
+}
+
+#[test]
+fn new_says_a_count_above_the_maximum_is_too_many_not_malformed() {
+    let d = tmpdir("new-count-huge");
+    let target = d.join("disc.png");
+    disc(&target);
+    let (ok, _, err) = new_in(
+        &d,
+        &target,
+        "sphere:0.1*1000000000000000000000000000000",
+        &[],
+    );
+    assert!(
+        !ok && err.contains("is more than the 64 objects a list may hold")
+            && !err.contains("not a whole number"),
+        "{err}"
+    );
+}
+
+#[test]
+fn new_names_the_auto_item_and_the_picture_when_no_object_is_worth_launching() {
+    // A one-pixel line: every shadow of a 0.1 m cube (at least 10 x 10 pixels) covers a
+    // row of it at most.
+    let d = tmpdir("new-nothing-worth");
+    let target = d.join("line.png");
+    picture(&target, 160, 120, |x, y| y == 60 && (20..140).contains(&x));
+    let (ok, _, err) = new_in(&d, &target, "auto:box:0.1x0.1x0.1", &[]);
+    assert!(!ok && !err.contains("panicked"), "{err}");
+    assert!(
+        err.contains("--objects auto:box:0.1x0.1x0.1")
+            && err.contains(&format!("--target {}", target.display()))
+            && err.contains("120 dark pixels")
+            && err.contains("smaller objects")
+            && err.contains("--width"),
+        "{err}"
+    );
+}
+
+#[test]
+fn new_refuses_a_picture_whose_dark_part_is_smaller_than_any_shadow_of_the_objects() {
+    let d = tmpdir("new-dot");
+    // One dark pixel (0.025 m) against spheres of 0.1 m: designed and solved to IoU
+    // 0.014 before the fix, with no word.
+    let dot = d.join("dot.png");
+    picture(&dot, 64, 48, |x, y| x == 10 && y == 10);
+    let (ok, _, err) = new_in(&d, &dot, "sphere:0.1*2", &["--choose-by", "start"]);
+    assert!(!ok, "{err}");
+    assert!(
+        err.contains(&format!("--target {}", dot.display()))
+            && err.contains("dark part (1 pixel of 64 x 48")
+            && err.contains("--objects sphere:0.1")
+            && err.contains("--width 6.549 or more"),
+        "{err}"
+    );
+    // A 2 x 2 dot in 8000 x 8000 pixels: 71 s of designs and trial solves to IoU 0
+    // before the fix; now refused before any design.
+    let huge = d.join("huge.png");
+    picture(&huge, 8000, 8000, |x, y| {
+        (3999..4001).contains(&x) && (3999..4001).contains(&y)
+    });
+    let start = std::time::Instant::now();
+    let (ok, _, err) = new_in(&d, &huge, "sphere:0.1*2", &[]);
+    assert!(
+        !ok && err.contains("dark part (4 pixels of 8000 x 8000"),
+        "{err}"
+    );
+    assert!(start.elapsed().as_secs() < 30, "{:?}", start.elapsed());
+    // The disc a sphere of 0.1 m casts is a picture it can draw.
+    let disc_png = d.join("disc.png");
+    disc(&disc_png);
+    let (ok, _, err) = new_in(&d, &disc_png, "sphere:0.1", &["--choose-by", "start"]);
+    assert!(ok, "{err}");
+}
+
+#[test]
+fn new_says_how_the_solver_treats_a_contact_as_the_scene_it_wrote_does() {
+    // A light 0.1 m high keeps the flights low: the start guess lands before t. The
+    // scene is written with the default contacts mode (a constraint), and the message
+    // said "the solver treats it as a penalty".
+    let d = tmpdir("new-contact-mode");
+    let target = root().join("scenes/mickey/target.png");
+    let (ok, out, err) = new_in(
+        &d,
+        &target,
+        "sphere:0.1*2",
+        &["--light-height", "0.1", "--choose-by", "start"],
+    );
+    assert!(ok, "{err}");
+    assert!(out.contains("with a contact at"), "{out}");
+    let scene = std::fs::read_to_string(d.join("out/scene.json")).unwrap();
+    assert!(!scene.contains("penalty"), "{scene}");
+    assert!(
+        !out.contains("penalty") && out.contains("the solver ranks launches without one first"),
+        "{out}"
+    );
+}
+
+#[test]
+fn new_and_plant_say_one_object_not_one_objects() {
+    let d = tmpdir("new-one-object");
+    let target = d.join("disc.png");
+    disc(&target);
+    let (ok, out, err) = new_in(&d, &target, "sphere:0.1", &["--choose-by", "start"]);
+    assert!(ok && out.contains("out: 1 object;"), "{out}{err}");
+    let (ok, out, err) = bsa_in(&d, &["plant", "planted", "--objects", "sphere:0.15"]);
+    assert!(ok && out.contains("planted: 1 object,"), "{out}{err}");
+}
+
+#[test]
+fn budget_errors_name_the_flag_to_change() {
+    let out = quick_solve(&root().join("scenes/mickey"), "budget-flags");
+    let dir = out.to_str().unwrap();
+    for (flag, value, says) in [
+        ("--rho", "-1", "air density"),
+        ("--cd", "-0.5", "drag coefficient"),
+        ("--speed-tol", "80", "speed tolerance"),
+        ("--direction-tol", "-1", "direction tolerance"),
+        ("--spin-tol", "200", "spin tolerance"),
+        ("--timing-tol", "-2", "timing tolerance"),
+        ("--cd-tol", "99", "cd tolerance"),
+        ("--samples", "0", "samples"),
+        ("--search-samples", "100000000", "search samples"),
+        ("--threads", "0", "threads"),
+        ("--iou-threshold", "1.2", "IoU threshold"),
+    ] {
+        let (ok, _, err) = bsa(&["budget", dir, flag, value, "-q"]);
+        assert!(!ok && !err.contains("panicked"), "{flag} {value}: {err}");
+        assert!(
+            err.contains(&format!("error: {flag}: ")) && err.contains(says),
+            "{flag} {value}: {err}"
+        );
+    }
+}

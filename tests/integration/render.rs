@@ -83,7 +83,20 @@ fn render_takes_a_minimal_launch_file_and_another_instant() {
 fn bad_launch_files_name_the_file_and_the_entry() {
     let d = tmpdir("render-bad");
     let scene = root().join("scenes/mickey");
-    let cases: [(&str, &str, &[&str]); 6] = [
+    let cases: [(&str, &str, &[&str]); 8] = [
+        (
+            // Under the speed limit, but 2400 rad by t: the solver would not fly it, and
+            // every shadow would silently be missing.
+            "spin.json",
+            r#"{"head": {"velocity": [0, 1, 6], "angular_velocity": [2000, 0, 0]},
+                "left_ear": {"velocity": [1, 0, 7]}, "right_ear": {"velocity": [-1, 0, 7]}}"#,
+            &["spin.json", "`head`", "`angular_velocity`", "2400 rad"],
+        ),
+        (
+            "fast.csv",
+            "name,vx_m_s,vy_m_s,vz_m_s,wx_rad_s,wy_rad_s,wz_rad_s\nhead,0,1,1e300,0,0,0\n",
+            &["fast.csv", "row 2", "`velocity`", "1e300 m/s"],
+        ),
         (
             "unknown.json",
             r#"{"head": {"velocity": [0, 1, 6]}, "left_ear": {"velocity": [1, 0, 7]},
@@ -481,5 +494,23 @@ fn new_keeps_the_design_that_solves_best_and_solve_ends_where_its_trial_did() {
     assert!(
         designed == committed,
         "scenes/fly/scene.json is not what `bsa new` designs today: run bash scripts/make-examples.sh"
+    );
+}
+
+#[test]
+fn eval_of_a_launch_table_points_to_render() {
+    let d = tmpdir("eval-csv");
+    let table = d.join("launch.csv");
+    std::fs::write(&table, "name,vx_m_s\n").unwrap();
+    let scene = root().join("scenes/mickey");
+    let (ok, _, err) = bsa(&[
+        "eval",
+        scene.to_str().unwrap(),
+        "--solution",
+        table.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("launch.csv") && err.contains("bsa render"),
+        "{err}"
     );
 }

@@ -139,3 +139,84 @@ fn occluders_overlapping_at_launch_are_refused() {
     });
     assert_rejected(&d, &["`head` and `left_ear` overlap"]);
 }
+
+#[test]
+fn gravity_that_does_not_pull_down_is_refused() {
+    for (name, g) in [("gravityup", 9.81), ("gravityflat", 0.0)] {
+        let d = variant(name, |v| v["gravity"] = serde_json::json!([0.0, 0.0, g]));
+        assert_rejected(&d, &["scene.json", "`gravity`", "must pull down"]);
+    }
+}
+
+#[test]
+fn instants_outside_a_hundredth_of_a_second_to_a_minute_are_refused() {
+    // A tiny `t` is named as itself, in a short form, not blamed on the timestep.
+    let d = variant("ttiny", |v| v["t"] = 1e-300.into());
+    assert_rejected(&d, &["`t`", "at least 0.01 s", "1e-300"]);
+    let d = variant("thour", |v| v["t"] = 3600.0.into());
+    assert_rejected(&d, &["`t`", "at most 60"]);
+}
+
+#[test]
+fn a_start_spin_of_more_than_2000_rad_by_t_is_refused() {
+    // 5000 rad/s is under the speed limit (1e4) but would turn the ear 6000 rad by
+    // t = 1.2 s: the solver treats such a sample as diverged, so every body's shadow
+    // would silently be missing.
+    let d = variant("spin", |v| {
+        v["occluders"][1]["start_angular_velocity"] = serde_json::json!([0.0, 0.0, 5000.0])
+    });
+    assert_rejected(
+        &d,
+        &[
+            "occluders[1].start_angular_velocity",
+            "6000 rad",
+            "at most 1666.7 rad/s",
+        ],
+    );
+}
+
+#[test]
+fn a_stage_whose_weights_are_all_zero_is_refused() {
+    for (name, w) in [
+        ("weights0", serde_json::json!({"xor": 0.0, "hint": 0.0})),
+        ("weightsempty", serde_json::json!({})),
+    ] {
+        let d = variant(name, move |v| v["stages"][0]["weights"] = w.clone());
+        assert_rejected(&d, &["stages[0].weights", "nothing to optimise"]);
+    }
+}
+
+#[test]
+fn wrong_values_inside_enums_name_their_path() {
+    // A shape of two kinds, and a hint's pixel of three numbers: serde alone says "expected
+    // value" and "did not match any variant".
+    let d = variant("twokinds", |v| {
+        v["occluders"][1]["shape"] =
+            serde_json::json!({"sphere": {"radius": 0.3}, "box": {"size": [0.1, 0.1, 0.1]}});
+    });
+    assert_rejected(&d, &["`occluders[1].shape`", "give one of"]);
+    let d = variant("shapefield", |v| {
+        v["occluders"][1]["shape"] = serde_json::json!({"sphere": {"radius": 0.3, "r": 1}});
+    });
+    assert_rejected(&d, &["`occluders[1].shape`", "unknown field `r`"]);
+    let d = variant("pixel3", |v| {
+        v["hints"][1]["pixel"] = serde_json::json!([1.0, 2.0, 3.0])
+    });
+    assert_rejected(&d, &["`hints`", "hint [1]", "`pixel`"]);
+    let d = variant("launchedtext", |v| {
+        v["occluders"][2]["launched"] = "yes".into()
+    });
+    assert_rejected(&d, &["`occluders[2].launched`", "expected a boolean"]);
+}
+
+#[cfg(unix)]
+#[test]
+fn endless_files_are_refused_instead_of_read() {
+    // A device as the mesh or the target: there is no length to check, and it never ends.
+    let d = variant("devmesh", |v| {
+        v["occluders"][0]["shape"] = serde_json::json!({"mesh": {"obj": "/dev/zero"}});
+    });
+    assert_rejected(&d, &["occluders[0].shape.mesh.obj", "not a regular file"]);
+    let d = variant("devtarget", |v| v["target"] = "/dev/zero".into());
+    assert_rejected(&d, &["/dev/zero", "256 MiB"]);
+}

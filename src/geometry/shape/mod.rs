@@ -276,6 +276,10 @@ pub fn load_obj_checked(path: &Path, scale: f64, limits: &ObjLimits) -> Result<T
     if meta.is_dir() {
         return Err(io(std::io::Error::other("it is a folder, not a file")));
     }
+    // A device or a pipe has no length to check against the limit, and may never end.
+    if !meta.is_file() {
+        return Err(io(std::io::Error::other("it is not a regular file")));
+    }
     if meta.len() > limits.max_bytes {
         return Err(ObjError::TooBig {
             path: path.to_path_buf(),
