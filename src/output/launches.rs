@@ -112,7 +112,10 @@ type Result<T> = std::result::Result<T, LaunchFileError>;
 
 /// One entry of a minimal launch file.
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "an entry {\"velocity\": [x, y, z], \"angular_velocity\": [x, y, z]}"
+)]
 struct Entry {
     velocity: [f64; 3],
     #[serde(default)]
@@ -154,9 +157,12 @@ pub fn read_launches(path: &Path, scene: &mut Scene) -> Result<Launches> {
             air: solution.air,
         });
     }
-    let entries: HashMap<String, Entry> = serde_json::from_value(value).map_err(|e| {
+    let entries: HashMap<String, Entry> = serde_path_to_error::deserialize(value).map_err(|e| {
+        let at = e.path().to_string();
+        let at = if at == "." { String::new() } else { format!("`{at}`: ") };
         format(format!(
-            "neither a solution.json nor a launch file ({{\"<occluder>\": {{\"velocity\": [x, y, z], \"angular_velocity\": [x, y, z]}}}}): {e}"
+            "neither a solution.json nor a launch file ({{\"<occluder>\": {{\"velocity\": [x, y, z], \"angular_velocity\": [x, y, z]}}}}): {at}{}",
+            e.into_inner()
         ))
     })?;
     let mut launches = Vec::new();

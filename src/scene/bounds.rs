@@ -5,7 +5,7 @@
 use glam::DVec3;
 
 use super::validate::Validator;
-use super::{Result, MAX_COORDINATE, MAX_T, MIN_T};
+use super::{Result, MAX_COORDINATE, MAX_T, MAX_WEIGHT, MIN_T};
 
 impl Validator<'_> {
     pub(super) fn finite(&self, field: &str, x: f64) -> Result<f64> {
@@ -44,6 +44,19 @@ impl Validator<'_> {
             Err(self.field_err(
                 field,
                 format!("must be at most {}, got {}", short(limit), short(x)),
+            ))
+        }
+    }
+
+    /// A weight: from 0 to [`MAX_WEIGHT`].
+    pub(super) fn weight(&self, field: &str, x: f64) -> Result<f64> {
+        let x = self.non_negative(field, x)?;
+        if x <= MAX_WEIGHT {
+            Ok(x)
+        } else {
+            Err(self.field_err(
+                field,
+                format!("must be from 0 to {}, got {}", short(MAX_WEIGHT), short(x)),
             ))
         }
     }

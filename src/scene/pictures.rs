@@ -83,8 +83,7 @@ impl Validator<'_> {
                     ));
                 }
             }
-            let weight = self.non_negative(&f("weight"), p.weight.unwrap_or(1.0))?;
-            let weight = self.within(&f("weight"), weight, MAX_WEIGHT)?;
+            let weight = self.weight(&f("weight"), p.weight.unwrap_or(1.0))?;
             if weight == 0.0 {
                 return Err(self.field_err(f("weight"), "must be positive"));
             }

@@ -545,8 +545,7 @@ impl Validator<'_> {
         let point = self.vec3(&format!("{field}.point"), h.point)?;
         let px = self.within(&format!("{field}.pixel[0]"), h.pixel[0], MAX_PIXEL)?;
         let py = self.within(&format!("{field}.pixel[1]"), h.pixel[1], MAX_PIXEL)?;
-        let weight = self.non_negative(&format!("{field}.weight"), h.weight.unwrap_or(1.0))?;
-        self.within(&format!("{field}.weight"), weight, MAX_WEIGHT)?;
+        let weight = self.weight(&format!("{field}.weight"), h.weight.unwrap_or(1.0))?;
         Ok(Hint {
             occluder,
             point,
@@ -631,8 +630,7 @@ impl Validator<'_> {
                     ),
                 )
             })?;
-            w[term as usize] = self.non_negative(&format!("{field}.weights.{key}"), *value)?;
-            self.within(&format!("{field}.weights.{key}"), *value, MAX_WEIGHT)?;
+            w[term as usize] = self.weight(&format!("{field}.weights.{key}"), *value)?;
         }
         if w.iter().all(|&x| x == 0.0) {
             return Err(self.field_err(

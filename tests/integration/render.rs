@@ -83,7 +83,12 @@ fn render_takes_a_minimal_launch_file_and_another_instant() {
 fn bad_launch_files_name_the_file_and_the_entry() {
     let d = tmpdir("render-bad");
     let scene = root().join("scenes/mickey");
-    let cases: [(&str, &str, &[&str]); 8] = [
+    let cases: [(&str, &str, &[&str]); 9] = [
+        (
+            "null.json",
+            r#"{"head": null, "left_ear": {"velocity": [1, 0, 7]}}"#,
+            &["null.json", "`head`", "expected an entry"],
+        ),
         (
             // Under the speed limit, but 2400 rad by t: the solver would not fly it, and
             // every shadow would silently be missing.

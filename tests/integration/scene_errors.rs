@@ -220,3 +220,9 @@ fn endless_files_are_refused_instead_of_read() {
     let d = variant("devtarget", |v| v["target"] = "/dev/zero".into());
     assert_rejected(&d, &["/dev/zero", "256 MiB"]);
 }
+
+#[test]
+fn a_weight_out_of_range_states_the_range_weights_take() {
+    let d = variant("hintweight", |v| v["hints"][0]["weight"] = 1e13.into());
+    assert_rejected(&d, &["hints[0].weight", "from 0 to 1e12", "1e13"]);
+}
