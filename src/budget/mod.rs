@@ -40,7 +40,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::energy::{self, Weights};
-use crate::evaluate::{Problem, Workspace, MAX_TURN};
+use crate::evaluate::{Problem, Workspace, MAX_THREADS, MAX_TURN};
 use crate::geometry::shape::Shape;
 use crate::output::solution::{check_solution, MismatchError, Solution};
 use crate::scene::Launch;
@@ -147,7 +147,7 @@ pub enum BudgetError {
         min: usize,
         max: usize,
     },
-    #[error("the number of threads must be at least 1")]
+    #[error("the number of threads must be from 1 to {MAX_THREADS}")]
     Threads,
     #[error("the IoU threshold must be greater than 0 and at most 1, got {0}")]
     Threshold(f64),
@@ -212,7 +212,10 @@ pub fn validate_options(problem: &Problem, opts: &BudgetOptions) -> Result<(), B
             max: MAX_SAMPLES,
         });
     }
-    if opts.threads == Some(0) {
+    if opts
+        .threads
+        .is_some_and(|n| !(1..=MAX_THREADS).contains(&n))
+    {
         return Err(BudgetError::Threads);
     }
     if !(opts.iou_threshold > 0.0 && opts.iou_threshold <= 1.0) {

@@ -56,9 +56,30 @@ pub(super) fn check_fps(fps: u32) -> Result<()> {
     Ok(())
 }
 
+/// An output file of `flag`: it must end in `.ext` and must not be a folder, so that a
+/// slip such as `--out DIR/solution.json` cannot put a film over a solve's files.
+pub(super) fn check_out(out: &Path, ext: &str, flag: &str) -> Result<()> {
+    if out.is_dir() {
+        bail!(
+            "{flag} {}: is a folder; give the file to write (NAME.{ext})",
+            out.display()
+        );
+    }
+    if !out.extension().is_some_and(|e| e.eq_ignore_ascii_case(ext)) {
+        bail!(
+            "{flag} {}: must name a .{ext} file (it would be written there)",
+            out.display()
+        );
+    }
+    Ok(())
+}
+
 impl Options {
     pub(super) fn new(args: BlendArgs) -> Result<Options> {
         check_fps(args.fps)?;
+        if let Some(out) = &args.out {
+            check_out(out, "blend", "--out")?;
+        }
         let resolution = parse_resolution(&args.resolution, "--resolution")?;
         Ok(Options {
             dir: args.dir,

@@ -86,7 +86,7 @@ impl Options {
 
 /// The command-line flag that sets the value an option error is about (`None` for a
 /// value no flag sets, such as the drag integrator's step).
-fn flag_of(e: &BudgetError) -> Option<&'static str> {
+pub(super) fn flag_of(e: &BudgetError) -> Option<&'static str> {
     Some(match e {
         BudgetError::Drag(DragError::Density(_)) => "--rho",
         BudgetError::Drag(DragError::Coefficient { .. }) => "--cd",

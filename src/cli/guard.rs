@@ -153,7 +153,7 @@ impl OutputGuard {
     pub fn keep_previous(&self) -> String {
         if !self.moved_previous {
             // A solve that failed before its first stage wrote nothing to point at.
-            if !self.path(SOLUTION).exists() {
+            if !self.path(SOLUTION).is_file() {
                 return "no solution was written".to_string();
             }
             return format!("the best so far is in {}", self.path(SOLUTION).display());

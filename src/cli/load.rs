@@ -53,6 +53,15 @@ pub(super) fn solution_and_scene(
     file: &Path,
     scene: Option<&Path>,
 ) -> Result<(Problem, Solution, PathBuf)> {
+    if dir.is_file() {
+        // The solution file itself where its folder was asked for.
+        let folder = dir.parent().filter(|p| !p.as_os_str().is_empty());
+        bail!(
+            "{} is a file: give the solve's output folder ({})",
+            dir.display(),
+            folder.map_or(".".into(), |p| p.display().to_string())
+        );
+    }
     if !file.is_file() {
         bail!(
             "{} has no solution.json: run `bsa solve <scene> --out {}` first",

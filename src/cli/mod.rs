@@ -118,7 +118,7 @@ struct SolveArgs {
     /// Random seed (overrides the scene's).
     #[arg(long)]
     seed: Option<u64>,
-    /// Worker threads [default: one per core].
+    /// Worker threads, 1 to 256 [default: one per core].
     #[arg(long)]
     threads: Option<usize>,
     /// Continue from the output folder's solution.json (skips its completed stages).
@@ -236,7 +236,7 @@ struct VideoArgs {
     #[arg(long, value_name = "FILE")]
     blend: Option<PathBuf>,
     /// Frames per second of the film (t is put on a whole frame).
-    #[arg(long, default_value_t = 24)]
+    #[arg(long, default_value_t = video::DEFAULT_FPS)]
     fps: u32,
     /// Frame size, WIDTHxHEIGHT in pixels, even [default: 1920x1080, or the --blend file's].
     #[arg(long, value_name = "WxH")]
@@ -281,7 +281,7 @@ struct BudgetArgs {
     /// Random seed of the Monte Carlo (the report is identical for a seed whatever the threads).
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Worker threads [default: one per core].
+    /// Worker threads, 1 to 256 [default: one per core].
     #[arg(long)]
     threads: Option<usize>,
     /// Air density (kg/m^3).

@@ -18,13 +18,11 @@ use crate::sim::drag::DragConfig;
 
 use super::progress::SolveProgress;
 use super::{export, frames, guard, load, outdir, SolveArgs};
+use crate::evaluate::MAX_THREADS;
 
 /// Ctrl-C presses so far. The solver reads it between iterations: one press ends the
 /// current stage, a second one stops and saves the best so far.
 static INTERRUPTS: AtomicUsize = AtomicUsize::new(0);
-
-/// The most worker threads `--threads` accepts.
-const MAX_THREADS: usize = 1024;
 
 /// The validated options of `bsa solve`.
 pub(super) struct Options {
@@ -196,9 +194,13 @@ fn problem(opts: &Options, mut scene: crate::scene::Scene) -> Result<Problem> {
         scene.positions = LaunchPositions::Free;
     }
     if let Some(r) = &opts.robust {
-        r.tolerances
-            .validate(scene.t)
-            .context("the tolerances of --robust")?;
+        if let Err(e) = r.tolerances.validate(scene.t) {
+            // Named by the flag to change, as `bsa budget` names it.
+            match super::budget::flag_of(&e) {
+                Some(flag) => bail!("{flag}: {e}"),
+                None => return Err(anyhow::Error::new(e).context("the tolerances of --robust")),
+            }
+        }
     }
     let mut problem = Problem::new(scene);
     if opts.air {
@@ -229,6 +231,33 @@ fn solve_into(
             .with_context(|| format!("cannot resume from {}", out.display()))?;
         solution::check_resumable(scene, &s)
             .with_context(|| format!("cannot resume from {}", file.display()))?;
+        // A resumed solve goes on as it was started: a different seed, or air or launch
+        // errors for some stages only, would silently mix two solves in one record.
+        let started = |what: String| {
+            anyhow::anyhow!(
+                "cannot resume from {}: it was started {what}, and --resume goes on as it was started; pass the same options, or solve afresh (--force)",
+                file.display()
+            )
+        };
+        if let Some(seed) = opts.seed.filter(|&x| x != s.seed) {
+            return Err(started(format!("with seed {}, not --seed {seed}", s.seed)));
+        }
+        if opts.air != s.air.is_some() {
+            let how = if opts.air {
+                "in vacuum, not --air"
+            } else {
+                "with --air"
+            };
+            return Err(started(how.to_string()));
+        }
+        if opts.robust.is_some() != s.robust.is_some() {
+            let how = if opts.robust.is_some() {
+                "without launch errors, not --robust"
+            } else {
+                "with --robust"
+            };
+            return Err(started(how.to_string()));
+        }
         if s.stages_completed >= s.stages_total {
             eprintln!(
                 "{}: all {} stages are done already; nothing to resume",

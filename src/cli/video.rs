@@ -12,6 +12,8 @@ use crate::output::{files, picture};
 
 use super::{blend, blender, VideoArgs};
 
+/// `--fps`'s default (`VideoArgs`).
+pub(super) const DEFAULT_FPS: u32 = 24;
 /// The view camera's default render size.
 const DEFAULT_RESOLUTION: [u32; 2] = [1920, 1080];
 /// The widest contact sheet (pixels).
@@ -64,6 +66,21 @@ impl Options {
                     b.display()
                 );
             }
+            // These options build the .blend; a given one is rendered as it is.
+            let building = [
+                (args.fps != DEFAULT_FPS, "--fps"),
+                (args.slowmo, "--slowmo"),
+                (args.curves, "--curves"),
+            ];
+            if let Some((_, flag)) = building.iter().find(|b| b.0) {
+                bail!(
+                    "{flag} builds the .blend, and --blend {} is rendered as it is: give one or the other (`bsa blend {flag} ...` writes a .blend with it)",
+                    b.display()
+                );
+            }
+        }
+        if let Some(out) = &args.out {
+            blend::check_out(out, "mp4", "--out")?;
         }
         Ok(Options {
             dir: args.dir,

@@ -222,7 +222,32 @@ fn bad_input_to_export_validate_and_video() {
 fn bad_options_of_blend_and_video() {
     let d = tmpdir("blend-options");
     let dir = d.to_str().unwrap();
+    // A .blend given to `video` (only its existence is checked before the options).
+    let given = d.join("given.blend");
+    std::fs::write(&given, b"not read").unwrap();
+    let given = given.to_str().unwrap();
+    let solution = d.join("solution.json");
+    let solution = solution.to_str().unwrap();
     for (args, says) in [
+        // An --out that would put the film over a solve's own files, or into a folder.
+        (
+            vec!["blend", dir, "--out", solution],
+            "must name a .blend file",
+        ),
+        (
+            vec!["video", dir, "--out", solution],
+            "must name a .mp4 file",
+        ),
+        (vec!["video", dir, "--out", dir], "is a folder"),
+        // Options that build a .blend, with a .blend to render as it is.
+        (
+            vec!["video", dir, "--blend", given, "--slowmo"],
+            "--slowmo builds the .blend",
+        ),
+        (
+            vec!["video", dir, "--blend", given, "--fps", "30"],
+            "--fps builds the .blend",
+        ),
         (vec!["blend", dir, "--fps", "0"], "--fps must be"),
         (vec!["blend", dir, "--fps", "1000"], "--fps must be"),
         (
@@ -625,4 +650,62 @@ fn budget_errors_name_the_flag_to_change() {
             "{flag} {value}: {err}"
         );
     }
+}
+
+#[test]
+fn resume_goes_on_as_the_solve_was_started_or_says_why_not() {
+    // A different seed, or air or launch errors for the remaining stages only, would
+    // silently mix two solves in one record.
+    let scene = root().join("scenes/mickey");
+    let out = quick_solve(&scene, "resume-options");
+    let dir = out.parent().unwrap().to_str().unwrap();
+    let out = out.to_str().unwrap();
+    for (extra, says) in [
+        (vec!["--seed", "99"], "not --seed 99"),
+        (vec!["--air"], "in vacuum, not --air"),
+        (vec!["--robust"], "without launch errors, not --robust"),
+    ] {
+        let mut args = vec!["solve", dir, "--out", out, "--resume", "-q"];
+        args.extend(extra.iter().copied());
+        let (ok, _, err) = bsa(&args);
+        assert!(!ok && err.contains(says), "{extra:?}: {err}");
+    }
+}
+
+#[test]
+fn budget_and_solve_refuse_more_threads_than_the_limit() {
+    let scene = root().join("scenes/mickey");
+    let out = quick_solve(&scene, "threads-limit");
+    let (ok, _, err) = bsa(&["budget", out.to_str().unwrap(), "--threads", "100000"]);
+    assert!(
+        !ok && err.contains("--threads") && err.contains("256"),
+        "{err}"
+    );
+    let (ok, _, err) = bsa(&["solve", scene.to_str().unwrap(), "--threads", "1000"]);
+    assert!(
+        !ok && err.contains("--threads must be between 1 and 256"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_solution_file_given_for_its_folder_and_a_robust_tolerance_name_what_to_change() {
+    let scene = root().join("scenes/mickey");
+    let out = quick_solve(&scene, "file-for-folder");
+    let file = out.join("solution.json");
+    let (ok, _, err) = bsa(&["export", file.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("is a file: give the solve's output folder"),
+        "{err}"
+    );
+    let (ok, _, err) = bsa(&[
+        "solve",
+        scene.to_str().unwrap(),
+        "--robust",
+        "--speed-tol",
+        "-1",
+        "--out",
+        out.with_file_name("robust").to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("--speed-tol:"), "{err}");
 }
