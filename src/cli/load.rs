@@ -79,7 +79,20 @@ pub(super) fn solution_and_scene(
             .filter(|p| p.exists())
             .unwrap_or_else(|| PathBuf::from("scenes").join(&solution.scene)),
     };
-    let problem = problem_for(self::scene(&scene_path)?, &solution);
+    let loaded = self::scene(&scene_path);
+    // The recorded scene file was gone and `scenes/<name>` was tried instead: say so,
+    // with both paths and the way out.
+    let loaded = match (&loaded, scene, &solution.scene_file) {
+        (Err(_), None, Some(recorded)) if !Path::new(recorded).exists() => loaded.with_context(|| {
+            format!(
+                "{} names the scene {recorded}, which does not exist, and {} could not stand in for it: put the scene back there, or pass it with --scene",
+                file.display(),
+                scene_path.display()
+            )
+        }),
+        _ => loaded,
+    };
+    let problem = problem_for(loaded?, &solution);
     Ok((problem, solution, scene_path))
 }
 

@@ -174,11 +174,24 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             out: out.display().to_string(),
         }
         .into()),
+        // Nothing ran: the folder's files are as they were, damaged or not.
+        Err(e) if e.downcast_ref::<NotResumed>().is_some() => Err(e),
         Err(e) => {
             // The cause comes first in the error below; where the files are is a note.
             eprintln!("note: {saved}");
             Err(e)
         }
+    }
+}
+
+/// The context of an error that refused to resume from a `solution.json`: no stage ran,
+/// and the output folder holds what it held.
+#[derive(Debug)]
+struct NotResumed(std::path::PathBuf);
+
+impl std::fmt::Display for NotResumed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "cannot resume from {}", self.0.display())
     }
 }
 
@@ -227,17 +240,15 @@ fn solve_into(
     let mut prior = Vec::new();
     let resume_from = if opts.resume {
         let file = out.join("solution.json");
-        let s = files::read_solution(&file)
-            .with_context(|| format!("cannot resume from {}", out.display()))?;
-        solution::check_resumable(scene, &s)
-            .with_context(|| format!("cannot resume from {}", file.display()))?;
+        let s = files::read_solution(&file).context(NotResumed(file.clone()))?;
+        solution::check_resumable(scene, &s).context(NotResumed(file.clone()))?;
         // A resumed solve goes on as it was started: a different seed, or air or launch
         // errors for some stages only, would silently mix two solves in one record.
         let started = |what: String| {
             anyhow::anyhow!(
-                "cannot resume from {}: it was started {what}, and --resume goes on as it was started; pass the same options, or solve afresh (--force)",
-                file.display()
+                "it was started {what}, and --resume goes on as it was started; pass the same options, or solve afresh (--force)"
             )
+            .context(NotResumed(file.clone()))
         };
         if let Some(seed) = opts.seed.filter(|&x| x != s.seed) {
             return Err(started(format!("with seed {}, not --seed {seed}", s.seed)));

@@ -709,3 +709,40 @@ fn a_solution_file_given_for_its_folder_and_a_robust_tolerance_name_what_to_chan
     ]);
     assert!(!ok && err.contains("--speed-tol:"), "{err}");
 }
+
+#[test]
+fn a_refused_resume_does_not_call_the_damaged_file_the_best_so_far() {
+    let scene = root().join("scenes/mickey");
+    let out = quick_solve(&scene, "resume-damaged");
+    let file = out.join("solution.json");
+    let text = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(&file, &text[..text.len() / 2]).unwrap();
+    let dir = out.parent().unwrap();
+    let (ok, _, err) = bsa(&[
+        "solve",
+        dir.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--resume",
+        "-q",
+    ]);
+    assert!(!ok && err.contains("cannot resume from"), "{err}");
+    assert!(!err.contains("best so far"), "{err}");
+}
+
+#[test]
+fn a_solution_whose_scene_file_is_gone_names_the_recorded_path() {
+    let scene = root().join("scenes/mickey");
+    let out = quick_solve(&scene, "scene-gone");
+    let file = out.join("solution.json");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    v["scene"] = "gone-scene".into();
+    v["scene_file"] = "../nowhere/scene.json".into();
+    std::fs::write(&file, serde_json::to_string(&v).unwrap()).unwrap();
+    let (ok, _, err) = bsa(&["export", out.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("nowhere/scene.json") && err.contains("--scene"),
+        "{err}"
+    );
+}
