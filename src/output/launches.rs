@@ -158,11 +158,9 @@ pub fn read_launches(path: &Path, scene: &mut Scene) -> Result<Launches> {
         });
     }
     let entries: HashMap<String, Entry> = serde_path_to_error::deserialize(value).map_err(|e| {
-        let at = e.path().to_string();
-        let at = if at == "." { String::new() } else { format!("`{at}`: ") };
         format(format!(
-            "neither a solution.json nor a launch file ({{\"<occluder>\": {{\"velocity\": [x, y, z], \"angular_velocity\": [x, y, z]}}}}): {at}{}",
-            e.into_inner()
+            "neither a solution.json nor a launch file ({{\"<occluder>\": {{\"velocity\": [x, y, z], \"angular_velocity\": [x, y, z]}}}}): {}",
+            crate::scene::at_path(e)
         ))
     })?;
     let mut launches = Vec::new();

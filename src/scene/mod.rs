@@ -83,6 +83,7 @@ mod start;
 mod validate;
 
 pub use launch::Launch;
+pub use raw::at_path;
 use raw::RawScene;
 pub use start::auto_order;
 pub use validate::too_fast_spin;
@@ -352,26 +353,20 @@ impl Scene {
         if !self.occluders[i].launched {
             return None;
         }
-        let (v, w) = (launch.velocity, launch.angular_velocity);
-        let speed = v.length();
+        // The length, or the largest component where the length overflows (1e300).
+        let size = |v: DVec3| {
+            Some(v.length())
+                .filter(|l| l.is_finite())
+                .unwrap_or(v.abs().max_element())
+        };
+        let (speed, spin) = (size(launch.velocity), size(launch.angular_velocity));
         if speed.is_nan() || speed > MAX_SPEED {
-            let speed = if speed.is_finite() {
-                speed
-            } else {
-                v.abs().max_element()
-            };
             return Some((
                 "velocity",
                 format!("has magnitude {speed:e} m/s, more than the {MAX_SPEED:e} allowed"),
             ));
         }
-        let spin = w.length();
         if spin.is_nan() || spin * self.horizon() > MAX_TURN {
-            let spin = if spin.is_finite() {
-                spin
-            } else {
-                w.abs().max_element()
-            };
             return Some(("angular_velocity", too_fast_spin(spin, self.horizon())));
         }
         None
@@ -504,23 +499,12 @@ pub fn load(path: &Path) -> Result<Scene> {
         path: file.clone(),
         source,
     })?;
-    // The path of the value at fault (`hints[0].pixel`) leads the message: serde's own
-    // errors give a line and column, and for an untagged or tagged enum only say that
-    // nothing matched.
     let raw: RawScene = serde_path_to_error::deserialize(&mut serde_json::Deserializer::from_str(
         &text,
     ))
-    .map_err(|e| {
-        let at = e.path().to_string();
-        let message = e.into_inner().to_string();
-        SceneError::Json {
-            path: file.clone(),
-            message: if at == "." {
-                message
-            } else {
-                format!("`{at}`: {message}")
-            },
-        }
+    .map_err(|e| SceneError::Json {
+        path: file.clone(),
+        message: raw::at_path(e),
     })?;
     let dir = file
         .parent()

@@ -50,50 +50,41 @@ pub(super) struct RawTable {
     pub(super) size: [f64; 3],
 }
 
-/// A shape: an object with exactly one of `sphere`, `box` and `mesh` (checked through
-/// a JSON value first: serde's message for two of them names neither).
+/// A shape: an object with exactly one of `sphere`, `box` and `mesh` (read by
+/// [`one_shape`]: serde's message for two of them names neither).
 #[derive(Deserialize)]
-#[serde(try_from = "serde_json::Value")]
+#[serde(deny_unknown_fields, rename_all = "snake_case")]
 pub(super) enum RawShape {
     Sphere { radius: f64 },
     Box { size: [f64; 3] },
     Mesh { obj: String, scale: Option<f64> },
 }
 
-/// [`RawShape`] as serde reads it once the value holds one kind.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields, rename_all = "snake_case")]
-enum TaggedShape {
-    Sphere { radius: f64 },
-    Box { size: [f64; 3] },
-    Mesh { obj: String, scale: Option<f64> },
+/// [`RawShape`], with an object of two kinds refused by name and an error inside the
+/// one kind named by its path (`sphere.radius`).
+fn one_shape<'de, D: serde::Deserializer<'de>>(d: D) -> Result<RawShape, D::Error> {
+    use serde::de::Error;
+    let value = serde_json::Value::deserialize(d)?;
+    if let Some(map) = value.as_object().filter(|m| m.len() > 1) {
+        let keys: Vec<&str> = map.keys().map(String::as_str).collect();
+        return Err(D::Error::custom(format!(
+            "give one of `sphere`, `box` and `mesh`, got {}",
+            keys.join(" and ")
+        )));
+    }
+    serde_path_to_error::deserialize(value).map_err(|e| D::Error::custom(at_path(e)))
 }
 
-impl TryFrom<serde_json::Value> for RawShape {
-    type Error = String;
-
-    fn try_from(value: serde_json::Value) -> Result<Self, String> {
-        if let Some(map) = value.as_object().filter(|m| m.len() > 1) {
-            let keys: Vec<&str> = map.keys().map(String::as_str).collect();
-            return Err(format!(
-                "give one of `sphere`, `box` and `mesh`, got {}",
-                keys.join(" and ")
-            ));
-        }
-        let shape = serde_path_to_error::deserialize(value).map_err(|e| {
-            let at = e.path().to_string();
-            let message = e.into_inner().to_string();
-            if at == "." {
-                message
-            } else {
-                format!("`{at}`: {message}")
-            }
-        })?;
-        Ok(match shape {
-            TaggedShape::Sphere { radius } => RawShape::Sphere { radius },
-            TaggedShape::Box { size } => RawShape::Box { size },
-            TaggedShape::Mesh { obj, scale } => RawShape::Mesh { obj, scale },
-        })
+/// A serde error led by the path of the value at fault (`hints[0].pixel: ...`), or alone
+/// at the top level: serde's own errors give a line and column, and for an untagged or
+/// tagged enum only say that nothing matched.
+pub fn at_path<E: std::fmt::Display>(e: serde_path_to_error::Error<E>) -> String {
+    let at = e.path().to_string();
+    let message = e.into_inner().to_string();
+    if at == "." {
+        message
+    } else {
+        format!("`{at}`: {message}")
     }
 }
 
@@ -101,6 +92,7 @@ impl TryFrom<serde_json::Value> for RawShape {
 #[serde(deny_unknown_fields)]
 pub(super) struct RawOccluder {
     pub(super) name: String,
+    #[serde(deserialize_with = "one_shape")]
     pub(super) shape: RawShape,
     pub(super) position: [f64; 3],
     pub(super) orientation: Option<[f64; 4]>,
@@ -131,10 +123,8 @@ impl TryFrom<serde_json::Value> for RawHints {
                 .into_iter()
                 .enumerate()
                 .map(|(k, item)| {
-                    serde_path_to_error::deserialize(item).map_err(|e| {
-                        let at = e.path().to_string();
-                        format!("hint [{k}], `{at}`: {}", e.into_inner())
-                    })
+                    serde_path_to_error::deserialize(item)
+                        .map_err(|e| format!("hint [{k}], {}", at_path(e)))
                 })
                 .collect::<Result<_, _>>()
                 .map(RawHints::Inline),
