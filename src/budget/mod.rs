@@ -133,7 +133,7 @@ impl Default for BudgetOptions {
 pub enum BudgetError {
     #[error(transparent)]
     Drag(#[from] DragError),
-    #[error("the {name} tolerance must be between 0 and {max} {unit}, got {value}")]
+    #[error("the {name} tolerance must be between 0 and {} {unit}, got {}", short(*.max), short(*.value))]
     Tolerance {
         name: &'static str,
         unit: &'static str,
@@ -149,7 +149,7 @@ pub enum BudgetError {
     },
     #[error("the number of threads must be from 1 to {MAX_THREADS}")]
     Threads,
-    #[error("the IoU threshold must be greater than 0 and at most 1, got {0}")]
+    #[error("the IoU threshold must be greater than 0 and at most 1, got {}", short(*.0))]
     Threshold(f64),
     #[error("the launch values hold {found} numbers, the scene needs {expected}")]
     Parameters { expected: usize, found: usize },
@@ -347,7 +347,9 @@ pub fn run(
     } else if b.vacuum_iou < opts.iou_threshold {
         notes.push(format!(
             "The vacuum solution reaches IoU {:.4} < threshold {}, but the drag-compensated launch reaches {:.4}.",
-            b.vacuum_iou, opts.iou_threshold, iou_comp
+            b.vacuum_iou,
+            short(opts.iou_threshold),
+            iou_comp
         ));
     }
     if diverged > 0 {

@@ -5,7 +5,7 @@
 //! (`budget_tolerances.{png,svg}`). Nothing here touches the filesystem: the caller
 //! saves the figures.
 
-use super::{BudgetReport, CurvePoint};
+use super::{short, BudgetReport, CurvePoint};
 use crate::output::picture::plot::{self, Figure, GridData, HistogramData, Panel};
 use crate::output::picture::PictureError;
 
@@ -25,7 +25,7 @@ pub fn histogram(r: &BudgetReport) -> Result<Figure, PictureError> {
             r.iou_threshold,
             format!(
                 "threshold {} (P = {:.1} %)",
-                r.iou_threshold,
+                short(r.iou_threshold),
                 100.0 * r.monte_carlo.p_iou_at_least_threshold
             ),
         )),
@@ -36,7 +36,7 @@ pub fn histogram(r: &BudgetReport) -> Result<Figure, PictureError> {
 /// tolerance marked; `None` when the report has no tolerance search.
 pub fn tolerances(r: &BudgetReport) -> Option<Result<Figure, PictureError>> {
     let search = r.search.as_ref()?;
-    let threshold = r.iou_threshold;
+    let threshold = short(r.iou_threshold);
     let panels = search
         .single
         .iter()

@@ -3,6 +3,18 @@
 
 use super::*;
 
+/// A number the user gave (a tolerance, a threshold, an air density) as people write it:
+/// plain from 1e-4 up to 1e5 (0.5, 2, 0.9), in exponent form beyond (1e-300, 1e300),
+/// which `{}` would print as three hundred digits. The form in which `scene` writes its
+/// limits.
+pub fn short(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e5).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// Everything `budget.json` holds.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct BudgetReport {
@@ -164,16 +176,17 @@ impl Unreachable {
             suggestion -= 0.05;
         }
         let suggested_threshold = (suggestion > 0.0).then_some(suggestion);
+        let shown = short(threshold);
         let what = if iou_vacuum < threshold {
-            format!("the vacuum solution reaches IoU {iou_vacuum:.4} < threshold {threshold}")
+            format!("the vacuum solution reaches IoU {iou_vacuum:.4} < threshold {shown}")
         } else {
             format!(
-                "the vacuum solution reaches IoU {iou_vacuum:.4} but the drag-compensated launch only {iou_compensated:.4} < threshold {threshold}"
+                "the vacuum solution reaches IoU {iou_vacuum:.4} but the drag-compensated launch only {iou_compensated:.4} < threshold {shown}"
             )
         };
         let message = match suggested_threshold {
             Some(s) => format!(
-                "{what}: no launcher precision can reach it (P(IoU >= {threshold}) is 0 at any tolerance); rerun with --iou-threshold {s}"
+                "{what}: no launcher precision can reach it (P(IoU >= {shown}) is 0 at any tolerance); rerun with --iou-threshold {s}"
             ),
             None => format!("{what}: no launcher precision can reach it"),
         };
@@ -207,13 +220,13 @@ impl BudgetReport {
         let _ = writeln!(
             s,
             "Shadow at t = {} s. Air: rho = {} kg/m^3; Cd sphere {}, box {}, mesh {}; Magnus lift {}; RK4 step <= {} s. Seed {}.\n",
-            self.t_s,
-            d.rho,
-            d.cd_sphere,
-            d.cd_box,
-            d.cd_mesh,
+            short(self.t_s),
+            short(d.rho),
+            short(d.cd_sphere),
+            short(d.cd_box),
+            short(d.cd_mesh),
             if d.magnus { "on" } else { "off" },
-            d.max_step,
+            short(d.max_step),
             self.seed
         );
         let _ = writeln!(s, "## Drag\n");
@@ -241,7 +254,7 @@ impl BudgetReport {
                 "| {} | {} | {} | {:.5} | {:.5} | {:.2} | {:.1} | {:.1e} | {:+.3} | {:.2e} | {} |",
                 o.name,
                 o.shape,
-                o.cd,
+                short(o.cd),
                 o.reference_area_m2,
                 o.drag_k_per_m,
                 o.terminal_speed_m_s,
@@ -262,12 +275,16 @@ impl BudgetReport {
         let _ = writeln!(
             s,
             "1-sigma errors per body: speed {} %, direction {} deg, spin {} %, release timing {} ms, drag coefficient {} %.\n",
-            t.speed_pct, t.direction_deg, t.spin_pct, t.timing_ms, t.cd_pct
+            short(t.speed_pct),
+            short(t.direction_deg),
+            short(t.spin_pct),
+            short(t.timing_ms),
+            short(t.cd_pct)
         );
         let _ = writeln!(
             s,
             "| mean IoU | 5th percentile | median | min | P(IoU >= {}) | diverged |\n|---|---|---|---|---|---|\n| {:.4} | {:.4} | {:.4} | {:.4} | {:.1} % | {} |\n",
-            self.iou_threshold,
+            short(self.iou_threshold),
             m.mean,
             m.p5,
             m.median,
@@ -302,7 +319,7 @@ impl BudgetReport {
             let _ = writeln!(
                 s,
                 "\n## Largest tolerances keeping P(IoU >= {}) >= {} %\n\nUnreachable at any tolerance, so not searched: {}.\n",
-                self.iou_threshold,
+                short(self.iou_threshold),
                 100.0 * self.probability_target,
                 u.message
             );
@@ -311,7 +328,7 @@ impl BudgetReport {
             let _ = writeln!(
                 s,
                 "\n## Largest tolerances keeping P(IoU >= {}) >= {} %\n\n{} samples per evaluation (the same draws at every size).\n",
-                self.iou_threshold,
+                short(self.iou_threshold),
                 100.0 * self.probability_target,
                 se.samples_per_evaluation
             );

@@ -17,14 +17,14 @@ const MICKEY: [f64; 18] = [
 ];
 
 /// A small scene of a tumbling brick (asymmetric box) and a knight (asymmetric mesh,
-/// 0.5 m tall), written to a temporary folder.
-fn box_and_mesh() -> Problem {
+/// 0.5 m tall), written to a temporary folder: its problem and the folder's guard, which
+/// the test keeps so that the folder is removed when it passes and kept when it fails.
+fn box_and_mesh() -> (Problem, crate::test_temp::TempPath) {
     // A folder per call: the tests run in parallel threads of one process, and one
     // test must not read the scene file while another writes it.
     static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
-    let d = std::env::temp_dir().join(format!("bsa-budget-{}-{call}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
+    let d = crate::test_temp::TempPath::dir("bsa-budget", &call.to_string());
     let scene = serde_json::json!({
         "name": "dragtest",
         "target": root().join("scenes/mickey/target.png"),
@@ -40,7 +40,7 @@ fn box_and_mesh() -> Problem {
     });
     let f = d.join("scene.json");
     std::fs::write(&f, serde_json::to_string(&scene).unwrap()).unwrap();
-    Problem::new(crate::scene::load(&f).unwrap())
+    (Problem::new(crate::scene::load(&f).unwrap()), d)
 }
 
 const BOX_AND_MESH: [f64; 12] = [
@@ -110,7 +110,7 @@ fn compensation_restores_the_vacuum_poses_for_mickey() {
 
 #[test]
 fn compensation_restores_the_vacuum_poses_for_a_box_and_a_mesh() {
-    let p = box_and_mesh();
+    let (p, _dir) = box_and_mesh();
     check_compensation(&p, &BOX_AND_MESH, "box+mesh");
 }
 

@@ -55,7 +55,17 @@ pub(super) fn run(python: &Path, script: &Path, args: &[String]) -> Result<serde
         .lines()
         .rev()
         .find_map(|l| l.strip_prefix("BSA_RESULT "));
-    let value: Option<serde_json::Value> = line.and_then(|l| serde_json::from_str(l).ok());
+    let value: Option<serde_json::Value> = match line {
+        Some(l) => Some(serde_json::from_str(l).with_context(|| {
+            let l: String = l.chars().take(200).collect();
+            format!(
+                "{} printed a result line that is not JSON under {}: BSA_RESULT {l}",
+                script.display(),
+                python.display()
+            )
+        })?),
+        None => None,
+    };
     match value {
         Some(v) if out.status.success() && v.get("error").is_none() => Ok(v),
         Some(v) => bail!(
@@ -72,6 +82,22 @@ pub(super) fn run(python: &Path, script: &Path, args: &[String]) -> Result<serde
             if err.contains("No module named 'bpy'") {
                 bail!(
                     "{} has no bpy module: run `bash blender/setup_venv.sh`, or pass --python",
+                    python.display()
+                );
+            }
+            // Success without the line: the interpreter did not run the script as
+            // Blender's Python does (`/bin/true`, a wrapper that swallows its output);
+            // "failed (exit status: 0)" said nothing of that.
+            if out.status.success() {
+                let said = if tail.is_empty() {
+                    String::new()
+                } else {
+                    format!("; its error output ends:\n{}", tail.join("\n"))
+                };
+                bail!(
+                    "{} ended without its result line (BSA_RESULT) under the interpreter {}, which exited with status 0: \
+                     pass --python (or set BSA_PYTHON) to a Python with Blender's bpy module (`bash blender/setup_venv.sh` makes .venv-blender/bin/python){said}",
+                    script.display(),
                     python.display()
                 );
             }

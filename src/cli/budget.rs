@@ -5,9 +5,9 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 
-use crate::budget::{self, plots, BudgetError, BudgetOptions, Tolerances};
+use crate::budget::{self, plots, short, BudgetError, BudgetOptions, Tolerances};
 use crate::evaluate::Problem;
 use crate::output::files;
 use crate::sim::drag::{DragConfig, DragError};
@@ -66,7 +66,12 @@ impl Options {
         budget::validate_options(problem, &self.budget).map_err(|e| match flag_of(&e) {
             Some(flag) => anyhow::anyhow!("{flag}: {e}"),
             None => anyhow::Error::new(e).context("invalid budget options"),
-        })
+        })?;
+        check_some_error(
+            &self.budget.tolerances,
+            true,
+            "every Monte Carlo launch would be the compensated launch itself, and there would be no requested tolerance to scale",
+        )
     }
 
     /// The output folder and the solution file of [`Options::path`].
@@ -82,6 +87,29 @@ impl Options {
             (path.to_path_buf(), path.join("solution.json"))
         }
     }
+}
+
+/// The flags of the launch errors, in the order of [`Tolerances::to_array`].
+const TOLERANCE_FLAGS: [&str; 5] = [
+    "--speed-tol",
+    "--direction-tol",
+    "--spin-tol",
+    "--timing-tol",
+    "--cd-tol",
+];
+
+/// Refuses launch errors that are all zero, naming their flags: every perturbed launch
+/// would then be the nominal one, and `why` says what that makes of the command.
+/// `with_cd`: whether the drag coefficient's error is one of them (it is only with air).
+pub(super) fn check_some_error(t: &Tolerances, with_cd: bool, why: &str) -> Result<()> {
+    let n = if with_cd { 5 } else { 4 };
+    if t.to_array()[..n].iter().all(|&x| x == 0.0) {
+        bail!(
+            "{} are all 0: {why}; give at least one of them a tolerance above 0",
+            TOLERANCE_FLAGS[..n].join(", ")
+        );
+    }
+    Ok(())
 }
 
 /// The command-line flag that sets the value an option error is about (`None` for a
@@ -180,7 +208,16 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let t = &r.tolerances;
     println!(
         "  Monte Carlo ({} samples; speed {} %, direction {} deg, spin {} %, timing {} ms, Cd {} %): mean IoU {:.4}, 5th percentile {:.4}, P(IoU >= {}) {:.1} %",
-        m.samples, t.speed_pct, t.direction_deg, t.spin_pct, t.timing_ms, t.cd_pct, m.mean, m.p5, r.iou_threshold, 100.0 * m.p_iou_at_least_threshold
+        m.samples,
+        short(t.speed_pct),
+        short(t.direction_deg),
+        short(t.spin_pct),
+        short(t.timing_ms),
+        short(t.cd_pct),
+        m.mean,
+        m.p5,
+        short(r.iou_threshold),
+        100.0 * m.p_iou_at_least_threshold
     );
     if let Some(u) = &r.threshold_unreachable {
         println!("  threshold unreachable: {}", u.message);
@@ -202,7 +239,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             .collect();
         println!(
             "  largest tolerances for P(IoU >= {}) >= {} %: alone {}; together x{:.3} of the requested",
-            r.iou_threshold,
+            short(r.iou_threshold),
             100.0 * r.probability_target,
             alone.join(", "),
             se.joint_scale

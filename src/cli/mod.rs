@@ -192,6 +192,12 @@ struct ValidateArgs {
     /// Python with the `bpy` module [default: $BSA_PYTHON, else .venv-blender/bin/python].
     #[arg(long)]
     python: Option<PathBuf>,
+    /// Exit with an error when Cycles and the rasterizer agree at an IoU below X (0 to
+    /// 1), at t or at any picture's instant; validate.json and the pictures are written
+    /// first. Cycles reproduces the shadows to a few pixels (IoU 0.9995 or more on the
+    /// examples).
+    #[arg(long, value_name = "X", default_value_t = validate::DEFAULT_MIN_IOU, allow_negative_numbers = true)]
+    min_iou: f64,
 }
 
 // Raw arguments of `bsa blend`.
@@ -430,7 +436,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Solve(args) => solve::run(&solve::Options::new(args)?),
         Command::Eval(args) => eval::run(&eval::Options::new(args)?),
         Command::Export(args) => export::run(&export::Options::new(args)?),
-        Command::Validate(args) => validate::run(&validate::Options::new(args)),
+        Command::Validate(args) => validate::run(&validate::Options::new(args)?),
         Command::Blend(args) => blend::run(&blend::Options::new(args)?),
         Command::Video(args) => video::run(&video::Options::new(args)?),
         Command::Budget(args) => budget::run(&budget::Options::new(args)),

@@ -234,6 +234,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         ..opts.stage.clone()
     };
     let dir = &opts.dir;
+    let created = !dir.exists();
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let probe_file = dir.join(SCRATCH_PROBE);
     // Every (order, ceiling) the design is made under, orders outermost.
@@ -250,6 +251,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             .chain(design_files.iter().cloned())
             .collect(),
         dir,
+        created,
     );
     files::write_atomic(&dir.join(SCRATCH_TARGET), &bytes)?;
     // With ctrlc's "termination" feature this handles SIGTERM (and SIGHUP) like Ctrl-C.
@@ -279,8 +281,11 @@ pub(super) fn run(opts: &Options) -> Result<()> {
                                      "position": [0.0, 0.0, 1.0], "density": 1000.0}]);
     }
     write(&probe_file, &probe)?;
-    let scene = load_probe(&probe_file, &probe, &protos, &opts.target, &write)?;
+    let (scene, light_err) = load_probe(&probe_file, &probe, &protos, &opts.target, &write)?;
     check_sizes(&scene, &protos)?;
+    if let Some(e) = light_err {
+        return Err(e);
+    }
     check_dark_part(&scene, &protos, &opts.target)?;
     let objects: Vec<Object> = protos
         .iter()
@@ -682,6 +687,18 @@ fn in_users_terms(err: anyhow::Error, target: &Path, protos: &[Prototype]) -> an
             Some(what) => anyhow::anyhow!("--objects: {what}: {error}"),
             None => err,
         },
+        Some(SceneError::NoRoomUnderLight {
+            index, room, width, ..
+        }) => match protos.get(*index) {
+            Some(p) => anyhow::anyhow!(
+                "--light-height {}: --objects {} is {} m thick where it is thinnest, so it can never pass whole between the light and the picture; raise the light above {} m (or check the units: metres)",
+                amount(*room),
+                p.describe(),
+                amount(*width),
+                amount(*width),
+            ),
+            None => err,
+        },
         Some(SceneError::Field { field, reason, .. }) => match object(field) {
             Some(what) => anyhow::anyhow!("--objects: {what}: {reason}"),
             None => err,
@@ -697,17 +714,35 @@ fn in_users_terms(err: anyhow::Error, target: &Path, protos: &[Prototype]) -> an
 /// wrote, which says nothing of what is wrong. Then each object is loaded again alone,
 /// with no table (one body overlaps nothing), so that its size is known and
 /// [`check_sizes`] can say what is wrong with it.
+///
+/// A light lower than an object is thick is told after the sizes (an object too large
+/// for the picture is the first thing to say): the scene is loaded under a light high
+/// above every object, and the error returned beside it.
 fn load_probe(
     file: &Path,
     probe: &Value,
     protos: &[Prototype],
     target: &Path,
     write: &dyn Fn(&Path, &Value) -> Result<()>,
-) -> Result<Scene> {
+) -> Result<(Scene, Option<anyhow::Error>)> {
     let err = match load::scene(file) {
-        Ok(scene) => return Ok(scene),
+        Ok(scene) => return Ok((scene, None)),
         Err(e) => e,
     };
+    let lifted = probe["light"][2].as_f64() == Some(PROBE_HIGH_LIGHT);
+    let no_room = |e: &anyhow::Error| {
+        matches!(
+            e.downcast_ref::<SceneError>(),
+            Some(SceneError::NoRoomUnderLight { .. })
+        )
+    };
+    if !lifted && no_room(&err) {
+        let mut high = probe.clone();
+        high["light"] = json!([0.0, 0.0, PROBE_HIGH_LIGHT]);
+        write(file, &high)?;
+        let (scene, _) = load_probe(file, &high, protos, target, write)?;
+        return Ok((scene, Some(in_users_terms(err, target, protos))));
+    }
     if !matches!(
         err.downcast_ref::<SceneError>(),
         Some(SceneError::Overlap { .. })
@@ -715,6 +750,7 @@ fn load_probe(
         return Err(in_users_terms(err, target, protos));
     }
     let mut first: Option<Scene> = None;
+    let mut light_err = None;
     let mut occluders = Vec::with_capacity(protos.len());
     for (k, p) in protos.iter().enumerate() {
         let mut alone = probe.clone();
@@ -724,8 +760,18 @@ fn load_probe(
             o.remove("table");
         }
         write(file, &alone)?;
-        let scene =
-            load::scene(file).map_err(|e| in_users_terms(e, target, std::slice::from_ref(p)))?;
+        let in_terms = |e| in_users_terms(e, target, std::slice::from_ref(p));
+        let scene = match load::scene(file) {
+            Ok(scene) => scene,
+            // Its size is checked first, under a light high above it (as above).
+            Err(e) if !lifted && no_room(&e) => {
+                light_err.get_or_insert(in_terms(e));
+                alone["light"] = json!([0.0, 0.0, PROBE_HIGH_LIGHT]);
+                write(file, &alone)?;
+                load::scene(file).map_err(in_terms)?
+            }
+            Err(e) => return Err(in_terms(e)),
+        };
         occluders.extend(scene.occluders.iter().cloned());
         first.get_or_insert(scene);
     }
@@ -733,8 +779,13 @@ fn load_probe(
     // The designs take the objects' shapes from this scene, and the table's top from
     // it: none here, so the receiver's plane, where the first scene's table had it.
     scene.occluders = occluders;
-    Ok(scene)
+    Ok((scene, light_err))
 }
+
+/// The light's height (m) under which [`load_probe`] loads objects thicker than the
+/// light the user asked for is high, so that their sizes are checked first: the
+/// highest a scene allows.
+const PROBE_HIGH_LIGHT: f64 = crate::scene::MAX_COORDINATE;
 
 /// A length or area for a message: three decimals at everyday sizes, a power of ten
 /// beyond them (a mesh of +-5e5 m is 1732050.808 m across otherwise, and a shadow of

@@ -91,6 +91,7 @@ fn read_inventory(arg: &str) -> Result<Inventory> {
 pub(super) fn run(opts: &Options) -> Result<()> {
     let layout = Layout::new(opts.stage.clone(), &opts.items)?;
     let dir = &opts.dir;
+    let created = !dir.exists();
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let name = dir
         .file_name()
@@ -101,7 +102,11 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     // The draw works in scratch files: the folder's scene is replaced only once the new
     // one is complete (see `scratch`).
     let (scratch_target, scratch_scene) = (".bsa-plant-target.png", ".bsa-plant-scene.json");
-    let scratch = Scratch::new(vec![dir.join(scratch_target), dir.join(scratch_scene)], dir);
+    let scratch = Scratch::new(
+        vec![dir.join(scratch_target), dir.join(scratch_scene)],
+        dir,
+        created,
+    );
     let write_scene =
         |file: &str, target: &str, hints: &[(usize, glam::DVec3, glam::DVec2)]| -> Result<()> {
             let json = layout.scene_json(&name, target, hints, opts.seed);
@@ -115,7 +120,18 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let placeholder = Mask::from_fn(w, h, |x, y| x == w / 2 && y == h / 2);
     write_target(&dir.join(scratch_target), &placeholder)?;
     write_scene(scratch_scene, scratch_target, &[])?;
-    let problem = Problem::new(load::scene(&dir.join(scratch_scene))?);
+    let scene = load::scene(&dir.join(scratch_scene)).map_err(|e| {
+        // Told in the options' terms: the scratch scene is no file of the user's.
+        match e.downcast_ref::<crate::scene::SceneError>() {
+            Some(crate::scene::SceneError::NoRoomUnderLight {
+                name, room, width, ..
+            }) => anyhow::anyhow!(
+                "--light-height {room}: object `{name}` of --objects is {width:.3} m thick where it is thinnest, so it can never pass whole between the light and the picture; raise the light above {width:.3} m (or check the units: metres)"
+            ),
+            _ => e,
+        }
+    })?;
+    let problem = Problem::new(scene);
     let params = plant::draw_launch(&problem, opts.seed, ATTEMPTS)?;
     let mut ws = problem.workspace();
     problem.evaluate(&params, &Weights::default(), &mut ws);

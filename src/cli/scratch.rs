@@ -15,11 +15,14 @@ pub(super) struct Scratch {
     pieces_before: Option<Vec<PathBuf>>,
     /// Set by [`Scratch::written`]: the pieces beside the scene stay.
     written: bool,
+    /// The scene's folder, when this command created it: removed again if it is left
+    /// empty without a scene (a refused `bsa new` leaves no empty folder behind).
+    created: Option<PathBuf>,
 }
 
 impl Scratch {
-    /// Scratch `files` in the scene's folder `dir`.
-    pub(super) fn new(files: Vec<PathBuf>, dir: &Path) -> Scratch {
+    /// Scratch `files` in the scene's folder `dir`, which this command `created`.
+    pub(super) fn new(files: Vec<PathBuf>, dir: &Path, created: bool) -> Scratch {
         let pieces = dir.join("pieces");
         let pieces_before = list(&pieces);
         Scratch {
@@ -27,6 +30,7 @@ impl Scratch {
             pieces,
             pieces_before,
             written: false,
+            created: created.then(|| dir.to_path_buf()),
         }
     }
 
@@ -58,6 +62,10 @@ impl Drop for Scratch {
         }
         if self.pieces_before.is_none() {
             let _ = std::fs::remove_dir(&self.pieces);
+        }
+        if let Some(dir) = &self.created {
+            // Removes only an empty folder.
+            let _ = std::fs::remove_dir(dir);
         }
     }
 }

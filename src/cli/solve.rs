@@ -74,8 +74,17 @@ impl Options {
                 bail!("--draws must be between 1 and {MAX_DRAWS}, got {draws}");
             }
             if let Some(q) = args.quantile {
+                // 1e-300 as written, not as three hundred digits.
+                let shown = crate::budget::short(q);
                 if !(q > 0.0 && q < 1.0) {
-                    bail!("--quantile must be between 0 and 1 (exclusive), got {q}");
+                    bail!("--quantile must be between 0 and 1 (exclusive), got {shown}");
+                }
+                // The quantile of one number is that number: the samples would be ranked
+                // by a single perturbed launch, as without --quantile.
+                if draws < 2 {
+                    bail!(
+                        "--quantile {shown} needs --draws 2 or more: with --draws {draws} it is the energy of a single perturbed launch"
+                    );
                 }
             }
             if args.cd_tol.is_some() && !args.air {
@@ -93,6 +102,11 @@ impl Options {
             if !args.air {
                 t.cd_pct = 0.0;
             }
+            super::budget::check_some_error(
+                &t,
+                args.air,
+                "every perturbed launch would be the nominal one, and --robust would optimise the plain objective (leave out --robust for that)",
+            )?;
             Some(Robust {
                 tolerances: t,
                 draws,

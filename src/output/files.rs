@@ -446,10 +446,8 @@ mod tests {
             .collect()
     }
 
-    fn dir(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("bsa-files-{}-{name}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
-        d
+    fn dir(name: &str) -> crate::test_temp::TempPath {
+        crate::test_temp::TempPath::dir("bsa-files", name)
     }
 
     #[test]

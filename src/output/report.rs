@@ -267,8 +267,7 @@ mod tests {
 
     #[test]
     fn page_is_self_contained_with_units_terms_in_order_and_the_budget_when_present() {
-        let dir = std::env::temp_dir().join(format!("bsa-report-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::test_temp::TempPath::dir("bsa-report", "page");
         std::fs::write(dir.join("overlay.png"), b"png bytes").unwrap();
         let page = report_html(&dir, &solution()).unwrap();
         assert!(!page.contains("http://") && !page.contains("https://"));
@@ -296,7 +295,6 @@ mod tests {
             !page.contains("![h]"),
             "image links of the Markdown are dropped"
         );
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

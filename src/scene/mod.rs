@@ -57,6 +57,16 @@ pub enum SceneError {
         field: String,
         error: shape::ObjError,
     },
+    /// A launched occluder is thicker, where it is thinnest, than the light is far from
+    /// the receiver: it can never pass whole between them.
+    #[error("{path}: field `light`: the light is {room:.4} m in front of the receiver, but occluders[{index}] (`{name}`) is {width:.4} m thick where it is thinnest, so it can never pass whole between the light and the receiver; move the light farther from the receiver (or check the units: metres)")]
+    NoRoomUnderLight {
+        path: PathBuf,
+        index: usize,
+        name: String,
+        room: f64,
+        width: f64,
+    },
     /// A line of a hints text file is malformed.
     #[error("{path}:{line}: {reason}")]
     HintLine {

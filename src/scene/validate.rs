@@ -185,6 +185,7 @@ impl Validator<'_> {
             ));
         }
         self.check_overlaps(&occluders, table.as_ref())?;
+        self.check_room_under_light(&occluders, &receiver, light)?;
         let pictures = self.with_hints(specs, &occluders)?;
         let hints: Vec<Hint> = pictures.iter().flat_map(|p| p.hints.clone()).collect();
         let positions = self.positions(raw.positions.as_deref(), table.is_some())?;
@@ -487,6 +488,41 @@ impl Validator<'_> {
                         ),
                     ));
                 }
+            }
+        }
+        Ok(())
+    }
+
+    /// Every launched body must fit between the receiver and the light, or it can never
+    /// cast a whole shadow: a light lower than a body is thick (a typo of centimetres
+    /// for metres, or a light put at the table's height) is inside or below the body
+    /// wherever it flies, and the solve ends at IoU near 0 with nothing to say why.
+    /// A body's least width is its width across the direction where it is thinnest
+    /// ([`least_width`]).
+    fn check_room_under_light(
+        &self,
+        occ: &[Occluder],
+        receiver: &Receiver,
+        light: DVec3,
+    ) -> Result<()> {
+        let room = (light - receiver.center).dot(receiver.normal);
+        for (i, o) in occ.iter().enumerate() {
+            if !o.launched {
+                continue;
+            }
+            // No body wider than its bounding sphere: most scenes need no more.
+            if 2.0 * o.bounding_radius < room {
+                continue;
+            }
+            let width = least_width(&o.shape);
+            if width >= room {
+                return Err(SceneError::NoRoomUnderLight {
+                    path: self.file.to_path_buf(),
+                    index: i,
+                    name: o.name.clone(),
+                    room,
+                    width,
+                });
             }
         }
         Ok(())
@@ -867,4 +903,35 @@ pub fn too_fast_spin(spin: f64, horizon: f64) -> String {
         spin * horizon,
         MAX_TURN / horizon
     )
+}
+
+/// Directions [`least_width`] tries for a mesh (a Fibonacci lattice over a half sphere:
+/// a width is the same both ways).
+const WIDTH_DIRECTIONS: usize = 2000;
+
+/// A lower bound of a solid's least width (m): exact for a sphere and a box; for a mesh,
+/// its least width over [`WIDTH_DIRECTIONS`] directions, less the most that the
+/// directions between them could lower it (the lattice's spacing times the mesh's
+/// diameter), so that no body is refused that could pass.
+fn least_width(shape: &Shape) -> f64 {
+    match shape {
+        Shape::Sphere { radius } => 2.0 * radius,
+        Shape::Cuboid { half_extents } => 2.0 * half_extents.min_element(),
+        Shape::Mesh(_) => {
+            let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+            let n = WIDTH_DIRECTIONS;
+            let mut least = f64::INFINITY;
+            for k in 0..n {
+                let z = 1.0 - (k as f64 + 0.5) / n as f64;
+                let r = (1.0 - z * z).sqrt();
+                let a = golden * k as f64;
+                let d = DVec3::new(r * a.cos(), r * a.sin(), z);
+                least = least.min(d.dot(shape.support(d) - shape.support(-d)));
+            }
+            // Neighbouring lattice points are about sqrt(2 pi / n) rad apart on the half
+            // sphere; a width changes by at most the diameter times the angle.
+            let spacing = (2.0 * std::f64::consts::PI / n as f64).sqrt();
+            (least - shape.bounding_radius(DVec3::ZERO) * 2.0 * spacing).max(0.0)
+        }
+    }
 }

@@ -387,14 +387,15 @@ mod tests {
     use crate::scene::Launch;
     use crate::sim::flight::{FlightConfig, FreeFlight, LaunchState};
 
-    fn scene_with(occluders: &str) -> Scene {
+    /// A scene of `occluders` and the guard of its folder, which the test keeps so that
+    /// the folder is removed when it passes and kept when it fails.
+    fn scene_with(occluders: &str) -> (Scene, crate::test_temp::TempPath) {
         // A folder of its own for each call: tests run side by side, and two scenes
         // keyed by their text's length (as they were) shared one when the lengths
         // matched, one test reading the target while the other wrote it.
         static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
         let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let dir = std::env::temp_dir().join(format!("bsa-cont-{}-{call}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::test_temp::TempPath::dir("bsa-cont", &call.to_string());
         image::GrayImage::from_fn(64, 48, |x, _| image::Luma([if x < 10 { 0 } else { 255 }]))
             .save(dir.join("t.png"))
             .unwrap();
@@ -406,7 +407,7 @@ mod tests {
                 "stages": [{{"weights": {{"xor": 1}}}}]}}"#
         );
         std::fs::write(dir.join("scene.json"), json).unwrap();
-        crate::scene::load(&dir).unwrap()
+        (crate::scene::load(&dir).unwrap(), dir)
     }
 
     /// rapier, fed the exact launch state with the half-step correction, follows the exact
@@ -417,7 +418,7 @@ mod tests {
     /// O((w h)^3) per substep). Without the correction the error is 3 cm (checked below).
     #[test]
     fn rapier_agrees_with_exact_flight_before_contact() {
-        let scene = scene_with(
+        let (scene, _dir) = scene_with(
             r#"[{"name": "a", "shape": {"sphere": {"radius": 0.3}}, "position": [0, -2, 0.3], "mass": 5},
                 {"name": "b", "shape": {"box": {"size": [0.3, 0.3, 0.3]}}, "position": [2, 0.5, 0.15], "mass": 2}]"#,
         );
@@ -494,7 +495,7 @@ mod tests {
 
     #[test]
     fn a_dropped_ball_lands_and_stays_above_the_table() {
-        let scene = scene_with(
+        let (scene, _dir) = scene_with(
             r#"[{"name": "a", "shape": {"sphere": {"radius": 0.3}}, "position": [0, 0, 0.3], "mass": 5}]"#,
         );
         let start = [BodyState {
@@ -521,7 +522,7 @@ mod tests {
     }
 
     fn ball_on_table(velocity: DVec3, angular_velocity: DVec3) -> (Scene, [BodyState; 1]) {
-        let scene = scene_with(
+        let (scene, _dir) = scene_with(
             r#"[{"name": "a", "shape": {"sphere": {"radius": 0.3}}, "position": [0, 0, 0.3], "mass": 5}]"#,
         );
         let start = [BodyState {

@@ -7,7 +7,7 @@
 use bsa::evaluate::Problem;
 
 use crate::util::{
-    blender_script, bsa, example_scenes, last_key_time, quick_solve, require, root,
+    blender_script, bsa, example_scenes, last_key_time, quick_solve, read_json, require, root,
     shared_quick_solve, tmpdir,
 };
 
@@ -35,6 +35,42 @@ fn cycles_mask_matches_the_rasterizer() {
             assert!(std::path::Path::new(diff).is_file(), "{diff}");
         }
     }
+}
+
+/// `validate` is a check: a .glb of another scene (fly's blocks for Mickey's solution)
+/// fails it with the IoU and the threshold named, after it wrote its report and pictures.
+/// It exited 0 at any IoU.
+#[test]
+#[ignore = "needs Blender's bpy in .venv-blender (bash blender/setup_venv.sh); run by scripts/test.sh"]
+fn validate_fails_below_its_min_iou_after_writing_its_report() {
+    let mickey = shared_quick_solve("mickey");
+    let fly = shared_quick_solve("fly");
+    let d = tmpdir("validate-other-glb");
+    std::fs::copy(mickey.join("solution.json"), d.join("solution.json")).unwrap();
+    std::fs::copy(fly.join("fly.glb"), d.join("mickey.glb")).unwrap();
+    let dir = d.to_str().unwrap();
+    let (ok, _, err) = bsa(&["validate", dir, "--scene", "scenes/mickey"]);
+    assert!(
+        !ok && err.contains("error: Cycles and the rasterizer disagree: IoU ")
+            && err.contains("below --min-iou 0.99"),
+        "{err}"
+    );
+    let v = read_json(&d.join("validate.json"));
+    assert!(v["iou"].as_f64().unwrap() < 0.99, "{v}");
+    assert_eq!(v["min_iou"], 0.99);
+    for f in ["cycles_mask.png", "validate_diff.png"] {
+        assert!(d.join(f).is_file(), "{f} missing");
+    }
+    // The user sets the bar.
+    let (ok, _, err) = bsa(&[
+        "validate",
+        dir,
+        "--scene",
+        "scenes/mickey",
+        "--min-iou",
+        "0",
+    ]);
+    assert!(ok, "{err}");
 }
 
 #[test]

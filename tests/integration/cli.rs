@@ -217,7 +217,8 @@ fn bad_input_to_export_validate_and_video() {
     assert!(!ok && err.contains("not a valid solution file"), "{err}");
 }
 
-/// `blend` and `video` refuse bad options with the option's name, before any work.
+/// `blend`, `video` and `validate` refuse bad options with the option's name, before any
+/// work.
 #[test]
 fn bad_options_of_blend_and_video() {
     let d = tmpdir("blend-options");
@@ -278,11 +279,50 @@ fn bad_options_of_blend_and_video() {
             vec!["video", dir, "--blend", "/nonexistent/a.blend"],
             "--blend /nonexistent/a.blend: no such file",
         ),
+        // An IoU is from 0 to 1.
+        (
+            vec!["validate", dir, "--min-iou", "1.5"],
+            "--min-iou must be an IoU from 0 to 1, got 1.5",
+        ),
+        (
+            vec!["validate", dir, "--min-iou", "-0.1"],
+            "--min-iou must be",
+        ),
+        (
+            vec!["validate", dir, "--min-iou", "NaN"],
+            "--min-iou must be",
+        ),
+        (
+            vec!["validate", dir, "--min-iou", "inf"],
+            "--min-iou must be",
+        ),
     ] {
         let (ok, _, err) = bsa(&args);
         assert!(
             !ok && err.contains(says) && !err.contains("panicked"),
             "{args:?}: {err}"
+        );
+    }
+}
+
+/// An interpreter that exits 0 without running Blender's script (`/bin/true`) is named,
+/// and the missing result line said: the message was "failed (exit status: 0)".
+#[test]
+fn a_python_that_ends_without_the_scripts_result_line_is_named() {
+    let out = quick_solve(&root().join("scenes/mickey"), "python-true");
+    let dir = out.to_str().unwrap();
+    for (cmd, script) in [
+        ("blend", "make_blend.py"),
+        ("video", "make_blend.py"),
+        ("validate", "render_shadow.py"),
+    ] {
+        let (ok, _, err) = bsa(&[cmd, dir, "--python", "/bin/true"]);
+        assert!(
+            !ok && err.contains(&format!("{script} ended without its result line"))
+                && err.contains("under the interpreter /bin/true")
+                && err.contains("--python")
+                && !err.contains("exit status: 0"),
+            "{cmd}: {err}"
         );
     }
 }
@@ -594,15 +634,15 @@ fn new_refuses_a_picture_whose_dark_part_is_smaller_than_any_shadow_of_the_objec
 
 #[test]
 fn new_says_how_the_solver_treats_a_contact_as_the_scene_it_wrote_does() {
-    // A light 0.1 m high keeps the flights low: the start guess lands before t. The
-    // scene is written with the default contacts mode (a constraint), and the message
-    // said "the solver treats it as a penalty".
+    // A light 0.1 m high keeps the flights low: two long thin sticks' start guess
+    // lands before t. The scene is written with the default contacts mode (a
+    // constraint), and the message said "the solver treats it as a penalty".
     let d = tmpdir("new-contact-mode");
     let target = root().join("scenes/mickey/target.png");
     let (ok, out, err) = new_in(
         &d,
         &target,
-        "sphere:0.1*2",
+        "box:0.6x0.02x0.02*2",
         &["--light-height", "0.1", "--choose-by", "start"],
     );
     assert!(ok, "{err}");
@@ -613,6 +653,47 @@ fn new_says_how_the_solver_treats_a_contact_as_the_scene_it_wrote_does() {
         !out.contains("penalty") && out.contains("the solver ranks launches without one first"),
         "{out}"
     );
+}
+
+#[test]
+fn new_refuses_a_light_lower_than_an_object_is_thick() {
+    // Spheres 0.2 m across under a light 0.1 m up were designed and solved (the old
+    // version of the test above used them) though no launch can pass one whole
+    // between the light and the picture.
+    let d = tmpdir("new-light-too-low");
+    let target = root().join("scenes/mickey/target.png");
+    let (ok, _, err) = new_in(
+        &d,
+        &target,
+        "box:0.3x0.05x0.05,sphere:0.1*2",
+        &["--light-height", "0.15"],
+    );
+    assert!(!ok, "accepted");
+    assert!(
+        err.contains("--light-height 0.150")
+            && err.contains("--objects sphere:0.1 is 0.200 m thick")
+            && err.contains("raise the light above 0.200 m")
+            && !err.contains("probe"),
+        "{err}"
+    );
+    assert!(!d.join("out").exists(), "left a folder behind");
+    // `bsa plant` says it in its options' terms too, not of its scratch scene.
+    let planted = d.join("planted");
+    let (ok, _, err) = bsa(&[
+        "plant",
+        planted.to_str().unwrap(),
+        "--objects",
+        "sphere:0.2",
+        "--light-height",
+        "0.3",
+    ]);
+    assert!(!ok, "accepted");
+    assert!(
+        err.contains("--light-height 0.3: object `sphere_1` of --objects is 0.400 m thick")
+            && !err.contains(".bsa-plant"),
+        "{err}"
+    );
+    assert!(!planted.exists(), "left a folder behind");
 }
 
 #[test]
@@ -649,6 +730,74 @@ fn budget_errors_name_the_flag_to_change() {
             err.contains(&format!("error: {flag}: ")) && err.contains(says),
             "{flag} {value}: {err}"
         );
+    }
+    // No launch error at all: every Monte Carlo launch would be the same one.
+    let (ok, _, err) = bsa(&[
+        "budget",
+        dir,
+        "--speed-tol",
+        "0",
+        "--direction-tol",
+        "0",
+        "--spin-tol",
+        "0",
+        "--timing-tol",
+        "0",
+        "--cd-tol",
+        "0",
+        "-q",
+    ]);
+    assert!(
+        !ok && err.contains(
+            "error: --speed-tol, --direction-tol, --spin-tol, --timing-tol, --cd-tol are all 0"
+        ),
+        "{err}"
+    );
+}
+
+/// Tiny and huge numbers the user gave read as written (1e-300), in the summary, the
+/// Markdown, the plots, the report page and the errors; `{}` printed three hundred
+/// digits.
+#[test]
+fn budget_prints_tiny_and_huge_numbers_in_exponent_form() {
+    let out = quick_solve(&root().join("scenes/mickey"), "budget-exponents");
+    let dir = out.to_str().unwrap();
+    let digits = |text: &str| text.contains("0000000000") || text.contains("9999999999");
+    let (ok, stdout, err) = bsa(&[
+        "budget",
+        dir,
+        "--iou-threshold",
+        "1e-300",
+        "--speed-tol",
+        "1e-300",
+        "--samples",
+        "40",
+        "--search-samples",
+        "40",
+        "-q",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        stdout.contains("P(IoU >= 1e-300)") && stdout.contains("speed 1e-300 %"),
+        "{stdout}"
+    );
+    assert!(!digits(&stdout), "{stdout}");
+    for file in [
+        "budget.md",
+        "report.html",
+        "budget_hist.svg",
+        "budget_tolerances.svg",
+    ] {
+        let text = std::fs::read_to_string(out.join(file)).unwrap();
+        assert!(text.contains("1e-300"), "{file}: {text}");
+        assert!(!digits(&text), "{file} has a long run of digits");
+    }
+    for (flag, says) in [
+        ("--iou-threshold", "at most 1, got 1e300"),
+        ("--speed-tol", "between 0 and 50 %, got 1e300"),
+    ] {
+        let (ok, _, err) = bsa(&["budget", dir, flag, "1e300", "-q"]);
+        assert!(!ok && err.contains(says) && !digits(&err), "{flag}: {err}");
     }
 }
 

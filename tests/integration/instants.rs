@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use crate::scene_errors::assert_rejected as rejected;
-use crate::util::{bsa, quick_solve, read_json, root, solve, tmpdir, variant};
+use crate::util::{bsa, quick_solve, read_json, root, solve, tmpdir, variant, TempDir};
 
 /// Mickey's stages cut to a few iterations, so that a solve takes a fraction of a second.
 fn short(v: &mut serde_json::Value) {
@@ -73,7 +73,7 @@ fn bad_hold_windows_are_refused_naming_the_field() {
 }
 
 /// Mickey in the sequence form, with `pictures` as its `targets`.
-fn sequence_variant(name: &str, pictures: serde_json::Value) -> std::path::PathBuf {
+fn sequence_variant(name: &str, pictures: serde_json::Value) -> TempDir {
     variant(name, |v| {
         let o = v.as_object_mut().unwrap();
         o.remove("target");
@@ -161,6 +161,48 @@ fn bad_positions_and_robust_options_are_refused() {
             "--cd-tol is the error of the drag model",
         ),
         (vec!["--robust", "--speed-tol", "-1"], "speed tolerance"),
+        (
+            vec!["--robust", "--quantile", "1e300"],
+            "between 0 and 1 (exclusive), got 1e300",
+        ),
+        // The quantile of a single perturbed launch is that launch's energy.
+        (
+            vec!["--robust", "--draws", "1", "--quantile", "0.9"],
+            "--quantile 0.9 needs --draws 2 or more",
+        ),
+        // No launch error at all: the robust objective is the plain one. In a vacuum
+        // the drag coefficient has none to give.
+        (
+            vec![
+                "--robust",
+                "--speed-tol",
+                "0",
+                "--direction-tol",
+                "0",
+                "--spin-tol",
+                "0",
+                "--timing-tol",
+                "0",
+            ],
+            "--speed-tol, --direction-tol, --spin-tol, --timing-tol are all 0",
+        ),
+        (
+            vec![
+                "--robust",
+                "--air",
+                "--speed-tol",
+                "0",
+                "--direction-tol",
+                "0",
+                "--spin-tol",
+                "0",
+                "--timing-tol",
+                "0",
+                "--cd-tol",
+                "0",
+            ],
+            "--speed-tol, --direction-tol, --spin-tol, --timing-tol, --cd-tol are all 0",
+        ),
     ] {
         let out = tmpdir("robust-bad");
         let mut a = vec!["solve", s, "--out", out.to_str().unwrap(), "-q"];

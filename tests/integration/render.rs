@@ -208,7 +208,7 @@ fn new_mickey(dir: &Path, objects: &str) -> (bool, String, String) {
 
 #[test]
 fn new_designs_a_scene_that_solve_takes_as_it_is() {
-    let dir = tmpdir("new").join("mickey");
+    let dir = tmpdir("new").into_child("mickey");
     let (ok, out, err) = new_mickey(&dir, "sphere:0.6,sphere:0.35*2");
     assert!(ok && out.contains("start guess IoU"), "{err}");
     // Three spheres for Mickey's three discs: nothing to note.
@@ -228,7 +228,7 @@ fn new_designs_a_scene_that_solve_takes_as_it_is() {
 fn new_tells_when_the_objects_cannot_cover_the_picture() {
     // One small sphere for Mickey's head and two ears: most of the picture stays bare
     // whatever the solve does, and the user is told what to bring.
-    let dir = tmpdir("new-few").join("mickey");
+    let dir = tmpdir("new-few").into_child("mickey");
     let (ok, _, err) = new_mickey(&dir, "sphere:0.35");
     assert!(ok, "{err}");
     assert!(

@@ -3,11 +3,11 @@
 //! in the output folder survives an interrupted or failing solve, as a scene in its
 //! folder survives a `bsa new` or `bsa plant` that fails or is interrupted.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::util::{bsa, root, tmpdir, variant};
+use crate::util::{bsa, root, tmpdir, variant, TempDir};
 
 /// `bsa check` on the scene in `dir` fails cleanly, its first stderr line naming `field`.
 fn assert_refused(dir: &Path, field: &str) {
@@ -106,7 +106,7 @@ fn audit_magnitudes_are_refused_naming_the_field() {
 }
 
 /// A scene of one mesh occluder (the OBJ text given) in a fresh folder.
-fn mesh_scene(name: &str, obj: Option<&str>, scale: Option<f64>) -> PathBuf {
+fn mesh_scene(name: &str, obj: Option<&str>, scale: Option<f64>) -> TempDir {
     let d = variant(name, |v| {
         v["occluders"][0]["shape"] = serde_json::json!({ "mesh": { "obj": "m.obj" } });
         if let Some(s) = scale {
@@ -168,7 +168,7 @@ fn export_refuses_an_unbounded_continuation() {
 }
 
 /// A quick Mickey (a few iterations) and a slow one (stages that run until stopped).
-fn quick_and_slow(name: &str) -> (PathBuf, PathBuf) {
+fn quick_and_slow(name: &str) -> (TempDir, TempDir) {
     let quick = variant(&format!("{name}-quick"), |v| {
         for s in v["stages"].as_array_mut().unwrap() {
             s["max_iterations"] = 3.into();
@@ -446,7 +446,7 @@ fn output_piped_into_a_reader_that_goes_away_is_no_panic() {
 }
 
 /// A folder holding a scene of its own: its `scene.json` and `target.png` (Mickey's).
-fn folder_with_a_scene(name: &str) -> (PathBuf, Vec<u8>, Vec<u8>) {
+fn folder_with_a_scene(name: &str) -> (TempDir, Vec<u8>, Vec<u8>) {
     let dir = tmpdir(name);
     let scene = b"{\"a scene\": \"of the user's\"}".to_vec();
     let target = std::fs::read(root().join("scenes/mickey/target.png")).unwrap();

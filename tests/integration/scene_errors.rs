@@ -149,6 +149,31 @@ fn gravity_that_does_not_pull_down_is_refused() {
 }
 
 #[test]
+fn a_light_nearer_the_receiver_than_a_body_is_thick_is_refused() {
+    // Mickey's head is 1.2 m across: under a light 0.3 m up it solved to IoU 0.06 with
+    // no word of why.
+    let d = variant("lightlow", |v| {
+        v["light"] = serde_json::json!([0.0, 0.0, 0.3])
+    });
+    assert_rejected(
+        &d,
+        &[
+            "scene.json",
+            "`light`",
+            "0.3000 m",
+            "`head`",
+            "1.2000 m thick",
+        ],
+    );
+    // A light just above the head's width is allowed.
+    let d = variant("lightjust", |v| {
+        v["light"] = serde_json::json!([0.0, 0.0, 1.25])
+    });
+    let (ok, _, err) = bsa(&["check", d.to_str().unwrap()]);
+    assert!(ok, "{err}");
+}
+
+#[test]
 fn instants_outside_a_hundredth_of_a_second_to_a_minute_are_refused() {
     // A tiny `t` is named as itself, in a short form, not blamed on the timestep.
     let d = variant("ttiny", |v| v["t"] = 1e-300.into());

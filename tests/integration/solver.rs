@@ -337,7 +337,7 @@ fn planted(name: &str, objects: &str, width: &str) -> (Problem, Vec<f64>) {
 
 /// [`planted`], from seed `seed`.
 fn planted_seed(name: &str, objects: &str, width: &str, seed: &str) -> (Problem, Vec<f64>) {
-    let dir = crate::util::tmpdir(name).join("pair");
+    let dir = crate::util::tmpdir(name).into_child("pair");
     let (ok, _, err) = crate::util::bsa(&[
         "plant",
         dir.to_str().unwrap(),

@@ -356,10 +356,10 @@ fn support_and_bounding_radius() {
 
 // ---------------------------------------------------------------- OBJ loading
 
-fn temp_obj(name: &str, text: &str) -> PathBuf {
-    let path = std::env::temp_dir().join(format!("body-test-{}-{name}.obj", std::process::id()));
-    std::fs::write(&path, text).unwrap();
-    path
+/// The OBJ file `text` in the temporary folder, removed when the guard is dropped after
+/// the test passed (kept when it failed).
+fn temp_obj(name: &str, text: &str) -> crate::test_temp::TempPath {
+    crate::test_temp::TempPath::file("body-test", &format!("{name}.obj"), text)
 }
 
 const CUBE_OBJ: &str = "\
@@ -380,7 +380,6 @@ f 2//6 3//6 7//6 6//6
 fn load_obj_unit_cube_welds_and_scales() {
     let path = temp_obj("cube", CUBE_OBJ);
     let mesh = load_obj(&path, 0.05).unwrap();
-    std::fs::remove_file(&path).ok();
     assert_eq!(mesh.vertices.len(), 8);
     assert_eq!(mesh.triangles.len(), 12);
     assert!(mesh.is_closed_and_oriented());
@@ -406,7 +405,6 @@ fn load_obj_flips_inward_mesh() {
         .collect();
     let path = temp_obj("inward", &inward);
     let mesh = load_obj(&path, 1.0).unwrap();
-    std::fs::remove_file(&path).ok();
     assert!(mesh.is_closed_and_oriented());
     assert!(rel(mesh.signed_volume(), 1.0) < 1e-12);
 }
@@ -415,7 +413,6 @@ fn load_obj_flips_inward_mesh() {
 fn load_obj_reports_errors() {
     let path = temp_obj("nofaces", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\n");
     let err = load_obj(&path, 1.0).unwrap_err();
-    std::fs::remove_file(&path).ok();
     assert!(matches!(err, ObjError::NoFaces { .. }), "{err}");
 
     let missing = std::env::temp_dir().join("body-test-does-not-exist.obj");
@@ -427,11 +424,9 @@ fn load_obj_reports_errors() {
         "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 4 3 2 1\n",
     );
     let err = load_obj(&path, 1.0).unwrap_err();
-    std::fs::remove_file(&path).ok();
     assert!(matches!(err, ObjError::DegenerateVolume { .. }), "{err}");
 
     let path = temp_obj("cube-inf", CUBE_OBJ);
     let err = load_obj(&path, f64::INFINITY).unwrap_err();
-    std::fs::remove_file(&path).ok();
     assert!(matches!(err, ObjError::NonFiniteVertex { .. }), "{err}");
 }
