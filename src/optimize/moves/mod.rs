@@ -74,6 +74,11 @@
 //!   (or a queen the king's part, the king the bishop's, the bishop the queen's): three
 //!   wrong parts at once, where a swap of two leaves one wrong and often draws a worse
 //!   picture than the one it leaves. Such a call seats the meshes in every pass too.
+//!   A trade of meshes is offered even when its seats draw a worse picture (up to
+//!   [`TRADE_SLACK`] times the wrong pixels kept) and reported
+//!   ([`MoveReport::trades`]): a piece's seat in a cluster of overlapping pieces is
+//!   too coarse to show the trade that mends the cluster, so the solver searches the
+//!   reported trades when none is taken.
 //!
 //! Align, lay, the turns about a body's own axes, the seats and the exchanges ask for
 //! an orientation at `t`; the launch spin that reaches it is solved by Newton's method
@@ -105,7 +110,8 @@
 //! where no block is hidden). The trades draw one seat (a scan and its best pose
 //! refined) for each ordered pair of bodies of a group of different shapes (at most `b (b
 //! - 1)` for `b` blocks, [`MAX_MESH_TRADES`] for meshes) and cost at most
-//! [`TRADES`](pose::TRADES) samples more a pass, each polished.
+//! [`TRADES`](pose::TRADES) samples more a pass for blocks and
+//! [`MESH_TRADES`](pose::MESH_TRADES) for meshes, each polished.
 
 mod pose;
 mod spin;
@@ -192,6 +198,22 @@ pub struct MoveReport {
     pub exchanges: Vec<Exchange>,
     /// The energy of the launch kept without the contact term (as [`Exchange::free`]).
     pub kept_free: f64,
+    /// The trades of meshes of the last pass of a call that trades
+    /// ([`MoveOptions::trades`]), as seated and polished, best picture first, even those
+    /// that draw a worse picture than the launch kept (up to [`TRADE_SLACK`] times its
+    /// wrong pixels): a trade in a cluster of overlapping pieces draws a worse picture
+    /// until the pieces around have moved to make room, which a local search of the
+    /// traded pieces may do (the caller's). Empty when the last pass took a move.
+    pub trades: Vec<Trade>,
+}
+
+/// Two or three bodies each seated on the next one's place (see [`MoveReport::trades`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Trade {
+    pub launch: Vec<f64>,
+    pub bodies: Vec<usize>,
+    /// Its energy without the contact term (as [`Exchange::free`]).
+    pub free: f64,
 }
 
 /// Two bodies that took each other's pose and place.
@@ -209,6 +231,13 @@ pub struct Exchange {
 /// wrong (a body left too low behind a contact), and a swap of two bodies of close
 /// sizes only pays once both have the size of their new part.
 const DEPTH_STEPS: [f64; 3] = [0.16, 0.08, 0.04];
+
+/// A trade of meshes is offered (and reported, [`MoveReport::trades`]) when its seats
+/// draw fewer than this many times the wrong pixels of the picture kept (blocks: fewer
+/// than the picture kept). The planted chess 10903 (a rook, a bishop and a knight each
+/// on the next one's place in a cluster of four overlapping pieces) is mended by a trade
+/// whose seats draw 1.6 times the energy of the launch kept.
+const TRADE_SLACK: i64 = 4;
 
 /// Moves of a pass polished by [`Search::polish`]: those whose pictures rank first.
 const POLISHED: usize = 4;
@@ -366,6 +395,7 @@ pub fn improve(
     let mut chosen = params.to_vec();
     let mut flight = FreeFlight::default();
     let mut exchanges: Vec<Exchange> = Vec::new();
+    let mut trade_offers: Vec<Trade> = Vec::new();
     let pairs = movable
         .iter()
         .enumerate()
@@ -397,8 +427,12 @@ pub fn improve(
         // Every move of the pass, evaluated; the best few are then polished.
         let mut offers: Vec<Offer> = Vec::new();
         exchanges.clear();
+        // Offers made so far, and those of them that are trades of meshes.
+        let made = std::cell::Cell::new(0);
+        let mut mesh_trades = 0..0;
         let mut offer =
             |candidate: &[f64], bodies: &[usize], search: &mut Search, ws: &mut Workspace| {
+                made.set(made.get() + 1);
                 let eval = search.evaluate(candidate, ws);
                 offers.push(Offer {
                     launch: candidate.to_vec(),
@@ -640,14 +674,24 @@ pub fn improve(
             // ... and, when the caller asks, bodies of one kind and different shapes each
             // on the next one's place: the cycles the table of seats ranks best, refined.
             for group in &trades {
-                for cycle in seats.trade_scan(group, ws) {
+                let of_meshes = matches!(shape(group[0]), Shape::Mesh(_));
+                let (cap, slack) = if of_meshes {
+                    (pose::MESH_TRADES, TRADE_SLACK)
+                } else {
+                    (pose::TRADES, 1)
+                };
+                let first = made.get();
+                for cycle in seats.trade_scan(group, cap, ws) {
                     if let Some((cost, poses)) = seats.many(&cycle, SEAT_KEPT, ws) {
-                        if cost < wrong {
+                        if cost < slack * wrong {
                             let seated: Vec<(usize, (DVec3, DQuat))> =
                                 cycle.iter().map(|c| c.0).zip(poses).collect();
                             offer_seats(&seated, &mut search, ws);
                         }
                     }
+                }
+                if of_meshes {
+                    mesh_trades = first..made.get();
                 }
             }
             ws.poses.copy_from_slice(&current_poses);
@@ -668,6 +712,14 @@ pub fn improve(
                 offer(&candidate, &fitted, &mut search, ws);
             }
         }
+        trade_offers = offers[mesh_trades]
+            .iter()
+            .map(|o| Trade {
+                launch: o.launch.clone(),
+                bodies: o.bodies.clone(),
+                free: search.free(&o.eval),
+            })
+            .collect();
         // Polish the moves that made the best pictures (a move that made a poor one
         // seldom becomes the best by a change of depth), then take the best-ranked.
         offers.sort_by(|a, b| search.free(&a.eval).total_cmp(&search.free(&b.eval)));
@@ -720,8 +772,9 @@ pub fn improve(
                 params.copy_from_slice(&chosen);
                 *best = e;
                 report.accepted += 1;
-                // Exchanges of the launch before this move are stale.
+                // Exchanges and trades of the launch before this move are stale.
                 exchanges.clear();
+                trade_offers.clear();
             }
             None => break,
         }
@@ -732,6 +785,8 @@ pub fn improve(
     let kept = search.free(best);
     exchanges.sort_by(|a, b| a.free.total_cmp(&b.free));
     report.exchanges = exchanges;
+    trade_offers.sort_by(|a, b| a.free.total_cmp(&b.free));
+    report.trades = trade_offers;
     report.kept_free = kept;
     report.promising = search
         .promising

@@ -399,7 +399,7 @@ impl Seats<'_> {
     }
 
     /// Trades of places among `bodies` (of one kind) worth refining, best first, at most
-    /// [`TRADES`]: each two or three bodies of different shapes, each to be seated on
+    /// `cap`: each two or three bodies of different shapes, each to be seated on
     /// the place of the next (the last on the first's), as `(body, place)`.
     ///
     /// Each body is seated ([`seat_pose`], its scan's best pose refined) on the place of
@@ -413,6 +413,7 @@ impl Seats<'_> {
     pub(super) fn trade_scan(
         &self,
         blocks: &[usize],
+        cap: usize,
         ws: &mut Workspace,
     ) -> Vec<Vec<(usize, Place)>> {
         let target = &self.problem.target.mask;
@@ -464,7 +465,7 @@ impl Seats<'_> {
         cycles.sort_by_key(|c| c.0);
         cycles
             .into_iter()
-            .take(TRADES)
+            .take(cap)
             .filter_map(|(_, cycle)| {
                 (0..cycle.len())
                     .map(|k| {
@@ -647,9 +648,15 @@ const SPLIT_LEAST: f64 = 16.0;
 /// pictures.
 pub(super) const SPLITS: usize = 4;
 
-/// Trades that [`improve`](super::improve) refines ([`Seats::trade_scan`]), those
-/// ranked best by the scans.
+/// Trades of blocks that [`improve`](super::improve) refines ([`Seats::trade_scan`]),
+/// those ranked best by the scans.
 pub(super) const TRADES: usize = 4;
+
+/// Trades of meshes that [`improve`](super::improve) refines and reports
+/// ([`MoveReport::trades`](super::MoveReport::trades)): the table's ranks say little of
+/// them (a piece's scanned shadow is off by hundreds of pixels), so most of the table
+/// (six pieces make 15 pairs and 40 three-cycles at most).
+pub(super) const MESH_TRADES: usize = 40;
 
 /// [`fit_pose`] body `i` (whose pose at `t` `ws.poses` holds, as for every body in
 /// `vary`) on the picture of the held bodies and the other bodies of `vary`, and launch
