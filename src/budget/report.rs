@@ -3,17 +3,9 @@
 
 use super::*;
 
-/// A number the user gave (a tolerance, a threshold, an air density) as people write it:
-/// plain from 1e-4 up to 1e5 (0.5, 2, 0.9), in exponent form beyond (1e-300, 1e300),
-/// which `{}` would print as three hundred digits. The form in which `scene` writes its
-/// limits.
-pub fn short(x: f64) -> String {
-    if x == 0.0 || (1e-4..1e5).contains(&x.abs()) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
-}
+/// Numbers the user gave (a tolerance, a threshold, an air density) are written as
+/// `scene` writes its limits: plain from 1e-4 up to 1e5, in exponent form beyond.
+pub use crate::scene::short;
 
 /// Everything `budget.json` holds.
 #[derive(Clone, Debug, PartialEq, Serialize)]

@@ -26,13 +26,10 @@ impl Options {
     pub(super) fn new(args: ExportArgs) -> Result<Options> {
         let after = args.after;
         if !(after.is_finite() && (0.0..=MAX_T).contains(&after)) {
-            // 1e300 as written, not as three hundred digits.
-            let got = if after.abs() < 1e5 {
-                format!("{after}")
-            } else {
-                format!("{after:e}")
-            };
-            bail!("--after must be a number of seconds from 0 to {MAX_T}, got {got}");
+            bail!(
+                "--after must be a number of seconds from 0 to {MAX_T}, got {}",
+                crate::scene::short(after)
+            );
         }
         Ok(Options {
             dir: args.dir,

@@ -716,8 +716,8 @@ fn in_users_terms(err: anyhow::Error, target: &Path, protos: &[Prototype]) -> an
 /// [`check_sizes`] can say what is wrong with it.
 ///
 /// A light lower than an object is thick is told after the sizes (an object too large
-/// for the picture is the first thing to say): the scene is loaded under a light high
-/// above every object, and the error returned beside it.
+/// for the picture is the first thing to say): that object is loaded alone under a light
+/// high above it, and the error returned beside the scene.
 fn load_probe(
     file: &Path,
     probe: &Value,
@@ -729,24 +729,18 @@ fn load_probe(
         Ok(scene) => return Ok((scene, None)),
         Err(e) => e,
     };
-    let lifted = probe["light"][2].as_f64() == Some(PROBE_HIGH_LIGHT);
     let no_room = |e: &anyhow::Error| {
         matches!(
             e.downcast_ref::<SceneError>(),
             Some(SceneError::NoRoomUnderLight { .. })
         )
     };
-    if !lifted && no_room(&err) {
-        let mut high = probe.clone();
-        high["light"] = json!([0.0, 0.0, PROBE_HIGH_LIGHT]);
-        write(file, &high)?;
-        let (scene, _) = load_probe(file, &high, protos, target, write)?;
-        return Ok((scene, Some(in_users_terms(err, target, protos))));
-    }
-    if !matches!(
-        err.downcast_ref::<SceneError>(),
-        Some(SceneError::Overlap { .. })
-    ) {
+    if !no_room(&err)
+        && !matches!(
+            err.downcast_ref::<SceneError>(),
+            Some(SceneError::Overlap { .. })
+        )
+    {
         return Err(in_users_terms(err, target, protos));
     }
     let mut first: Option<Scene> = None;
@@ -763,8 +757,8 @@ fn load_probe(
         let in_terms = |e| in_users_terms(e, target, std::slice::from_ref(p));
         let scene = match load::scene(file) {
             Ok(scene) => scene,
-            // Its size is checked first, under a light high above it (as above).
-            Err(e) if !lifted && no_room(&e) => {
+            // Its size is checked first, under a light high above it.
+            Err(e) if no_room(&e) => {
                 light_err.get_or_insert(in_terms(e));
                 alone["light"] = json!([0.0, 0.0, PROBE_HIGH_LIGHT]);
                 write(file, &alone)?;

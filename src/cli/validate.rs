@@ -9,8 +9,8 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 
-use crate::budget::short;
 use crate::output::{cycles, files};
+use crate::scene::short;
 
 use super::{blender, load, ValidateArgs};
 

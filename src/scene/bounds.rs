@@ -124,8 +124,8 @@ impl Validator<'_> {
 }
 
 /// A number as people write limits: plain from 1e-4 up to 1e5 (3600, 0.5), in exponent
-/// form beyond (1e6, 1e300, 1e-300).
-pub(super) fn short(x: f64) -> String {
+/// form beyond (1e6, 1e300, 1e-300), which `{}` would print as three hundred digits.
+pub fn short(x: f64) -> String {
     if x == 0.0 || (1e-4..1e5).contains(&x.abs()) {
         format!("{x}")
     } else {

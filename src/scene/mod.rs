@@ -92,6 +92,7 @@ mod raw;
 mod start;
 mod validate;
 
+pub use bounds::short;
 pub use launch::Launch;
 pub use raw::at_path;
 use raw::RawScene;
