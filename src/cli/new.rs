@@ -10,7 +10,10 @@
 //! by default ([`ChooseBy::Solve`]) each design that differs from those before it is
 //! then solved as `bsa solve` will solve it (the scene's seed, the scene's strategy)
 //! and the one whose solve ends at the best picture, contact-free first, is written. A start guess's IoU says little of where its solve ends: on 27 held-out
-//! pictures the design with the best start was the best solved one for 12.
+//! pictures the design with the best start was the best solved one for 12. When no
+//! trial reaches [`design::REPLACE_BELOW`], a second [`Round`] designs every setting
+//! again with its objects placed anew ([`design::cover::Cover::replace`]) and solves
+//! those, and the best of both rounds is written.
 //!
 //! Until the scene is written, `bsa new` works in scratch files in the folder (a copy of
 //! the target, the first scene, one scene per design; [`Scratch`] removes them however
@@ -237,11 +240,22 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let created = !dir.exists();
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let probe_file = dir.join(SCRATCH_PROBE);
-    // Every (order, ceiling) the design is made under, orders outermost.
-    let settings: Vec<(Order, f64)> = design::ORDERS
-        .iter()
-        .flat_map(|&o| design::CEILINGS.iter().map(move |&c| (o, c)))
+    // Every (order, ceiling) the design is made under, orders outermost: first as
+    // greedy, exchanged and polished; then, in the second round, with every object
+    // placed anew too (`Setting::replace`).
+    let settings: Vec<Setting> = [false, true]
+        .into_iter()
+        .flat_map(|replace| {
+            design::ORDERS.iter().flat_map(move |&order| {
+                design::CEILINGS.iter().map(move |&ceiling| Setting {
+                    order,
+                    ceiling,
+                    replace,
+                })
+            })
+        })
         .collect();
+    let first_round = design::ORDERS.len() * design::CEILINGS.len();
     let design_files: Vec<PathBuf> = (0..settings.len())
         .map(|k| dir.join(format!(".bsa-new-design-{k}.json")))
         .collect();
@@ -319,76 +333,29 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     // then, by default, each design that differs from the others is solved. The best
     // (see `Variant::better_than`) is kept.
     let trial = opts.choose_by == ChooseBy::Solve;
-    let bar = progress::steps(
-        settings.len() as u64,
-        &format!(
-            "{name}: designing under {} ceilings and {} orders",
-            design::CEILINGS.len(),
-            design::ORDERS.len()
-        ),
-    );
-    let mut designed: Vec<Result<Variant>> = settings
-        .par_iter()
-        .enumerate()
-        .map(|(k, &(order, ceiling))| {
-            let geometry = Geometry {
-                ceiling,
-                ..geometry.clone()
-            };
-            let variant = unless_interrupted(|| {
-                design_variant(
-                    &picture,
-                    geometry,
-                    &request,
-                    order,
-                    &design_files[k],
-                    &name,
-                    opts.seed,
-                )
-            });
-            bar.inc(1);
-            variant
-        })
-        .collect();
-    bar.finish_and_clear();
-    // A design that another order made too (one kind of object, or the same choices)
-    // is solved once.
-    let scenes: Vec<Option<String>> = designed
+    let round = Round {
+        picture: &picture,
+        geometry: &geometry,
+        request: &request,
+        settings: &settings,
+        files: &design_files,
+        name: &name,
+        seed: opts.seed,
+        trial,
+    };
+    let mut designed: Vec<Result<Variant>> = Vec::new();
+    let mut same_as: Vec<Option<usize>> = Vec::new();
+    round.run(0..first_round, &mut designed, &mut same_as);
+    // When no trial solve reaches `design::REPLACE_BELOW`, every setting is designed
+    // again with its objects placed anew, and the best of both rounds is kept.
+    let best_trial = designed
         .iter()
-        .map(|v| {
-            v.as_ref().ok().map(|v| {
-                v.plan
-                    .scene_json(&name, SCRATCH_TARGET, opts.seed)
-                    .to_string()
-            })
-        })
-        .collect();
-    let same_as: Vec<Option<usize>> = (0..designed.len())
-        .map(|k| (0..k).find(|&j| scenes[k].is_some() && scenes[j] == scenes[k]))
-        .collect();
-    if trial {
-        let todo: Vec<usize> = (0..designed.len())
-            .filter(|&k| designed[k].is_ok() && same_as[k].is_none())
-            .collect();
-        let bar = progress::steps(todo.len() as u64, &format!("{name}: solving the designs"));
-        let solved: Vec<(usize, Result<Solved>)> = todo
-            .par_iter()
-            .map(|&k| {
-                let v = designed[k].as_ref().expect("a design to solve");
-                // One begun stops at once: its solver watches the same counter.
-                let s =
-                    unless_interrupted(|| trial_solve(&v.plan, &design_files[k], &name, opts.seed));
-                bar.inc(1);
-                (k, s)
-            })
-            .collect();
-        bar.finish_and_clear();
-        for (k, s) in solved {
-            match s {
-                Ok(s) => designed[k].as_mut().expect("a solved design").solved = Some(s),
-                Err(e) => designed[k] = Err(e),
-            }
-        }
+        .filter_map(|v| v.as_ref().ok()?.solved)
+        .filter(|s| s.clear)
+        .map(|s| s.iou)
+        .fold(f64::NEG_INFINITY, f64::max);
+    if trial && best_trial < design::REPLACE_BELOW && INTERRUPTS.load(Ordering::SeqCst) == 0 {
+        round.run(first_round..settings.len(), &mut designed, &mut same_as);
     }
     if INTERRUPTS.load(Ordering::SeqCst) > 0 {
         return Err(NothingWritten {
@@ -421,7 +388,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         plan,
         moves,
         solved,
-        order,
+        setting,
         ..
     }) = best
     else {
@@ -437,10 +404,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     )?;
     scratch.written();
     if trial {
-        println!(
-            "{name}: {}",
-            trials_line(&seen, (order, plan.geometry.ceiling))
-        );
+        println!("{name}: {}", trials_line(&seen, setting));
     }
     // What the user gets: the scene as written, loaded afresh.
     let problem = Problem::new(load::scene(dir)?);
@@ -541,7 +505,7 @@ struct Solved {
 /// One design of the picture under one ceiling and order, made contact-free.
 struct Variant {
     plan: Plan,
-    order: Order,
+    setting: Setting,
     /// Moves [`separate`] took.
     moves: usize,
     /// The start guess's IoU and whether it flies without contact before `t`.
@@ -580,35 +544,151 @@ enum Trial {
 }
 
 /// "trial solves under ceilings 0.8 / 0.7 / ... of the light's height: IoU a / b / ...
-/// (largest object first), e / same / ... (best fit first); kept the design under c,
-/// best fit first": what the choice was made on (a trial that ended with a contact
-/// says so; "same" is a design that an earlier order made too). `seen` is in the order
-/// of [`design::ORDERS`] then [`design::CEILINGS`].
-fn trials_line(seen: &[Trial], kept: (Order, f64)) -> String {
+/// (largest object first), e / same / ... (best fit first)[; placed anew: ...]; kept the
+/// design under c, best fit first[, placed anew]": what the choice was made on (a trial
+/// that ended with a contact says so; "same" is a design that an earlier one made too).
+/// `seen` is in the order of the settings: rounds, then [`design::ORDERS`], then
+/// [`design::CEILINGS`]; the second round only when it ran.
+fn trials_line(seen: &[Trial], kept: Setting) -> String {
     let ceilings: Vec<String> = design::CEILINGS.iter().map(|c| format!("{c}")).collect();
-    let per_order: Vec<String> = design::ORDERS
-        .iter()
-        .zip(seen.chunks(design::CEILINGS.len()))
-        .map(|(order, trials)| {
-            let ious: Vec<String> = trials
+    let per_round: Vec<String> = seen
+        .chunks(design::CEILINGS.len() * design::ORDERS.len())
+        .map(|round| {
+            let per_order: Vec<String> = design::ORDERS
                 .iter()
-                .map(|s| match s {
-                    Trial::Solved(Some(s)) if s.clear => format!("{:.4}", s.iou),
-                    Trial::Solved(Some(s)) => format!("{:.4} (contact)", s.iou),
-                    Trial::Solved(None) | Trial::Failed => "-".to_string(),
-                    Trial::Same => "same".to_string(),
+                .zip(round.chunks(design::CEILINGS.len()))
+                .map(|(order, trials)| {
+                    let ious: Vec<String> = trials
+                        .iter()
+                        .map(|s| match s {
+                            Trial::Solved(Some(s)) if s.clear => format!("{:.4}", s.iou),
+                            Trial::Solved(Some(s)) => format!("{:.4} (contact)", s.iou),
+                            Trial::Solved(None) | Trial::Failed => "-".to_string(),
+                            Trial::Same => "same".to_string(),
+                        })
+                        .collect();
+                    format!("{} ({})", ious.join(" / "), order.label())
                 })
                 .collect();
-            format!("{} ({})", ious.join(" / "), order.label())
+            per_order.join(", ")
         })
         .collect();
     format!(
-        "trial solves under ceilings {} of the light's height: IoU {}; kept the design under {}, {}",
+        "trial solves under ceilings {} of the light's height: IoU {}; kept the design under {}, {}{}",
         ceilings.join(" / "),
-        per_order.join(", "),
-        kept.1,
-        kept.0.label()
+        per_round.join("; placed anew: "),
+        kept.ceiling,
+        kept.order.label(),
+        if kept.replace { ", placed anew" } else { "" }
     )
+}
+
+/// What one design is made under.
+#[derive(Clone, Copy, Debug)]
+struct Setting {
+    order: Order,
+    /// The highest flight at `t`, as a share of the light's height ([`design::CEILINGS`]).
+    ceiling: f64,
+    /// Every object placed anew after the exchanges ([`design::cover::Cover::replace`]).
+    replace: bool,
+}
+
+/// What a round of designs needs: the picture, the objects and the settings, with one
+/// scratch file per setting.
+struct Round<'a> {
+    picture: &'a Picture,
+    geometry: &'a Geometry,
+    request: &'a Request,
+    settings: &'a [Setting],
+    files: &'a [PathBuf],
+    name: &'a str,
+    seed: u64,
+    /// Whether each design is trial-solved ([`ChooseBy::Solve`]).
+    trial: bool,
+}
+
+impl Round<'_> {
+    /// Design under the settings `ks` (in parallel, each made contact-free), append
+    /// them to `designed`, and to `same_as` the earlier design each repeats (one that
+    /// another order or round made too); with `trial`, solve each that repeats none.
+    fn run(
+        &self,
+        ks: std::ops::Range<usize>,
+        designed: &mut Vec<Result<Variant>>,
+        same_as: &mut Vec<Option<usize>>,
+    ) {
+        let (name, seed) = (self.name, self.seed);
+        let replace = ks.clone().any(|k| self.settings[k].replace);
+        let bar = progress::steps(
+            ks.len() as u64,
+            &format!(
+                "{name}: designing under {} ceilings and {} orders{}",
+                design::CEILINGS.len(),
+                design::ORDERS.len(),
+                if replace { ", objects placed anew" } else { "" }
+            ),
+        );
+        let made: Vec<Result<Variant>> = ks
+            .clone()
+            .into_par_iter()
+            .map(|k| {
+                let geometry = Geometry {
+                    ceiling: self.settings[k].ceiling,
+                    ..self.geometry.clone()
+                };
+                let variant = unless_interrupted(|| {
+                    design_variant(
+                        self.picture,
+                        geometry,
+                        self.request,
+                        self.settings[k],
+                        &self.files[k],
+                        name,
+                        seed,
+                    )
+                });
+                bar.inc(1);
+                variant
+            })
+            .collect();
+        bar.finish_and_clear();
+        designed.extend(made);
+        let scenes: Vec<Option<String>> = designed
+            .iter()
+            .map(|v| {
+                v.as_ref()
+                    .ok()
+                    .map(|v| v.plan.scene_json(name, SCRATCH_TARGET, seed).to_string())
+            })
+            .collect();
+        for k in ks.clone() {
+            same_as.push((0..k).find(|&j| scenes[k].is_some() && scenes[j] == scenes[k]));
+        }
+        if !self.trial {
+            return;
+        }
+        let todo: Vec<usize> = ks
+            .filter(|&k| designed[k].is_ok() && same_as[k].is_none())
+            .collect();
+        let bar = progress::steps(todo.len() as u64, &format!("{name}: solving the designs"));
+        let solved: Vec<(usize, Result<Solved>)> = todo
+            .par_iter()
+            .map(|&k| {
+                let v = designed[k].as_ref().expect("a design to solve");
+                // One begun stops at once: its solver watches the same counter.
+                let s = unless_interrupted(|| trial_solve(&v.plan, &self.files[k], name, seed));
+                bar.inc(1);
+                (k, s)
+            })
+            .collect();
+        bar.finish_and_clear();
+        for (k, s) in solved {
+            match s {
+                Ok(s) => designed[k].as_mut().expect("a solved design").solved = Some(s),
+                Err(e) => designed[k] = Err(e),
+            }
+        }
+    }
 }
 
 /// Design under `geometry`'s ceiling, write the scene to `file` (in the scene's folder),
@@ -617,12 +697,12 @@ fn design_variant(
     picture: &Picture,
     geometry: Geometry,
     request: &Request,
-    order: Order,
+    setting: Setting,
     file: &Path,
     name: &str,
     seed: u64,
 ) -> Result<Variant> {
-    let mut plan = design::design(picture, geometry, request, order)?;
+    let mut plan = design::design(picture, geometry, request, setting.order, setting.replace)?;
     let json = plan.scene_json(name, SCRATCH_TARGET, seed);
     files::write_atomic(file, serde_json::to_string_pretty(&json)?.as_bytes())?;
     let mut problem = Problem::new(load::scene(file)?);
@@ -633,7 +713,7 @@ fn design_variant(
     let start = problem.evaluate(&params, &Weights::default(), &mut ws);
     Ok(Variant {
         plan,
-        order,
+        setting,
         moves: sep.moves,
         iou: start.iou,
         clear: start.outcome.n_contacts == 0,

@@ -108,6 +108,13 @@ pub fn fit(p: &Placement) -> f64 {
     p.gain * precision * precision
 }
 
+/// When no trial solve of `bsa new`'s designs ends at this IoU or more, it designs
+/// every setting again with [`Cover::replace`] and keeps the best of both rounds. The
+/// second round costs as much as the first, so it runs only where the first leaves a
+/// picture that a solve's own moves rarely mend (the solver's trades start under the
+/// same IoU).
+pub const REPLACE_BELOW: f64 = 0.985;
+
 /// Rounds of [`Cover::polish`] after the greedy pass.
 pub const POLISH_ROUNDS: usize = 2;
 
@@ -191,12 +198,15 @@ pub fn check_dark_part(
 }
 
 /// Design a scene: place every object's shadow on `picture` (in `order`), add objects
-/// of the `auto:` kind while they gain enough, and plan the launches.
+/// of the `auto:` kind while they gain enough, exchange objects of different shapes
+/// where both fit better, with `replace` place each object anew where it gains more
+/// ([`Cover::replace`]), polish, and plan the launches.
 pub fn design(
     picture: &Picture,
     geometry: Geometry,
     request: &Request,
     order: Order,
+    replace: bool,
 ) -> Result<Plan, DesignError> {
     let frame = geometry.frame();
     let mut cover = Cover::new(picture, frame);
@@ -280,6 +290,9 @@ pub fn design(
         if cover.exchange(&fams, &|a, b| shapes[a] == shapes[b]) == 0 {
             break;
         }
+    }
+    if replace {
+        cover.replace(&fams);
     }
     cover.polish(POLISH_ROUNDS);
     Ok(Plan::new(geometry, objects, cover.placements))

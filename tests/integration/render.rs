@@ -213,6 +213,16 @@ fn new_designs_a_scene_that_solve_takes_as_it_is() {
     assert!(ok && out.contains("start guess IoU"), "{err}");
     // Three spheres for Mickey's three discs: nothing to note.
     assert!(!err.contains("note:"), "{err}");
+    // A trial reaches 0.985 (`design::REPLACE_BELOW`), so the designs are not made
+    // again with their objects placed anew.
+    let (_, orders, (_, kept)) = trials(&out);
+    let best = orders
+        .iter()
+        .flat_map(|o| o.1.iter().flatten().copied())
+        .fold(0.0, f64::max);
+    assert!(best >= 0.985, "{out}");
+    assert_eq!(orders.len(), 2, "{out}");
+    assert!(!kept.contains("placed anew"), "{out}");
     // Exactly the three files: the designs tried under the other ceilings are gone.
     let mut files: Vec<String> = std::fs::read_dir(&dir)
         .unwrap()
@@ -425,8 +435,8 @@ fn new_fly(dir: &Path, extra: &[&str]) -> String {
 }
 
 /// What `bsa new` printed of its trial solves: the ceilings, each order's trial IoUs
-/// (`None` for a design that an earlier order made too, "same") and the ceiling and
-/// order it kept.
+/// (`None` for a design that an earlier one made too, "same"; the second round's
+/// orders, when it ran, labelled "..., placed anew") and the ceiling and order it kept.
 type Trials = (Vec<f64>, Vec<(String, Vec<Option<f64>>)>, (f64, String));
 
 /// The trial solves' line of `bsa new`'s output, parsed ([`Trials`]).
@@ -443,17 +453,25 @@ fn trials(out: &str) -> Trials {
         .split(" / ")
         .map(|v| v.parse().unwrap())
         .collect();
-    let orders = between("IoU ", ";")
-        .split("), ")
-        .map(|part| {
-            let (ious, label) = part.split_once(" (").unwrap_or_else(|| panic!("{line}"));
+    let mut orders = Vec::new();
+    for (round, part) in between("IoU ", "; kept")
+        .split("; placed anew: ")
+        .enumerate()
+    {
+        for order in part.split("), ") {
+            let (ious, label) = order.split_once(" (").unwrap_or_else(|| panic!("{line}"));
             let ious = ious
                 .split(" / ")
                 .map(|v| (v != "same").then(|| v.parse().unwrap()))
                 .collect();
-            (label.trim_end_matches(')').to_string(), ious)
-        })
-        .collect();
+            let label = label.trim_end_matches(')');
+            let label = match round {
+                0 => label.to_string(),
+                _ => format!("{label}, placed anew"),
+            };
+            orders.push((label, ious));
+        }
+    }
     let (ceiling, order) = between("kept the design under ", "\n")
         .split_once(", ")
         .map(|(c, o)| (c.parse().unwrap(), o.to_string()))
@@ -470,8 +488,19 @@ fn new_keeps_the_design_that_solves_best_and_solve_ends_where_its_trial_did() {
     let out = new_fly(&dir, &[]);
     let (ceilings, orders, (ceiling, order)) = trials(&out);
     assert_eq!(ceilings.len(), 4, "{out}");
+    // Fly's trials end under 0.985 (`design::REPLACE_BELOW`), so its designs are made
+    // again with the objects placed anew, and the best of both rounds is kept.
     let labels: Vec<&str> = orders.iter().map(|o| o.0.as_str()).collect();
-    assert_eq!(labels, ["largest object first", "best fit first"], "{out}");
+    assert_eq!(
+        labels,
+        [
+            "largest object first",
+            "best fit first",
+            "largest object first, placed anew",
+            "best fit first, placed anew"
+        ],
+        "{out}"
+    );
     // Every design is solved once: the first order's all, the second's where it differs.
     assert!(orders[0].1.iter().all(Option::is_some), "{out}");
     assert!(orders.iter().all(|o| o.1.len() == 4), "{out}");
