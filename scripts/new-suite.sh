@@ -6,12 +6,13 @@
 # whole processes). The overlays are tiled into docs/images/new-suite[-auto].png.
 #
 #     bash scripts/new-suite.sh [SEED] [auto]      # defaults: seed 1, the stated boxes
-#     SET=2 bash scripts/new-suite.sh 1             # set 2 (tools/test-pictures-2), or 3 to 15
+#     SET=2 bash scripts/new-suite.sh 1             # set 2 (tools/test-pictures-2), or 3 to 17
 #
 # With `auto`, every picture gets one automatic item of its kind instead (auto:box of the
 # unit block for the block pictures, auto:sphere for the sphere one, auto:chess for the
 # chess ones) and the table gives the count chosen.
-# Scenes and solves go to /tmp/bsa-new-suite[-2][-auto]/<picture>/ and <picture>-out/;
+# Scenes and solves go to /tmp/bsa-new-suite[-2][-auto]/<picture>/ and <picture>-out/
+# (with <picture>-new.log, what `bsa new` printed);
 # the contact sheet to docs/images/new-suite[-2][-auto].png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -41,10 +42,12 @@ while IFS=$'\t' read -r name objects options; do
         esac
     fi
     dir=$root/$name
-    rm -rf "$dir" "$dir-out"
+    rm -rf "$dir" "$dir-out" "$dir-new.log"
     t0=$(date +%s.%N)
     # shellcheck disable=SC2086
     new=$("$bsa" new "$dir" --target "$pics/$name.png" --objects "$objects" --seed "$seed" $options)
+    # What `bsa new` printed (its trial solves and the design kept), beside the solve's log.
+    printf '%s\n' "$new" >"$dir-new.log"
     "$bsa" solve "$dir" -q --seed "$seed" --out "$dir-out" >"$dir-out.log"
     t1=$(date +%s.%N)
     start=$(sed -n 's/.*start guess IoU \([0-9.]*\).*/\1/p' <<<"$new")

@@ -989,6 +989,24 @@ mod tests {
         assert!(cover.open() < 2000, "{} target pixels left", cover.open());
     }
 
+    /// Commit object `k` in the first of its pose `families` at `centre` (pixels),
+    /// unturned, at magnification `m`, on a cover of 5 mm per pixel.
+    fn commit_flat(cover: &mut Cover, k: usize, families: &[Family], centre: DVec2, m: f64) {
+        let pose = families[0].pose(0.0);
+        let scale = m / 0.005;
+        let p = Placement {
+            object: k,
+            family: 0,
+            alpha: 0.0,
+            centre,
+            theta: 0.0,
+            m,
+            gain: 0.0,
+            area: pose.outline.area() * scale * scale,
+        };
+        cover.commit(p, families[0].clone());
+    }
+
     #[test]
     fn objects_on_each_others_places_are_exchanged() {
         // A square of 100 px and a bar of 150 x 50 px at 5 mm per pixel; a block of
@@ -1009,19 +1027,7 @@ mod tests {
             (0, &big, DVec2::new(90.0, 120.0), 1.7),
             (1, &cube, DVec2::new(245.0, 120.0), 2.5),
         ] {
-            let pose = fams[0].pose(0.0);
-            let scale = m / 0.005;
-            let p = Placement {
-                object: k,
-                family: 0,
-                alpha: 0.0,
-                centre,
-                theta: 0.0,
-                m,
-                gain: 0.0,
-                area: pose.outline.area() * scale * scale,
-            };
-            cover.commit(p, fams[0].clone());
+            commit_flat(&mut cover, k, fams, centre, m);
         }
         let on_square = |p: &Placement| p.centre.x < 155.0;
         let before = cover.open();
@@ -1060,19 +1066,7 @@ mod tests {
         });
         let mut cover = Cover::new(&pic, frame);
         for (k, m) in [(0, 5.0), (1, 3.0)] {
-            let pose = cube[0].pose(0.0);
-            let scale = m / 0.005;
-            let p = Placement {
-                object: k,
-                family: 0,
-                alpha: 0.0,
-                centre: DVec2::new(70.0, 120.0),
-                theta: 0.0,
-                m,
-                gain: 0.0,
-                area: pose.outline.area() * scale * scale,
-            };
-            cover.commit(p, cube[0].clone());
+            commit_flat(&mut cover, k, &cube, DVec2::new(70.0, 120.0), m);
         }
         let before = cover.open();
         assert!(before >= 10_000, "{before}");
