@@ -723,9 +723,9 @@ fn design_variant(
 
 /// Solve the design as `bsa solve` will solve the scene written from it: the same file
 /// (so the same start, strategy and seed), loaded afresh, but without the last stage's
-/// trades (`SolveOptions::skip_trades`: they compare designs, not rescues). One
-/// thread: the designs are solved side by side, and a solve's result does not depend
-/// on its thread count.
+/// trades and polish (`SolveOptions::skip_trades`, `skip_polish`: they compare designs,
+/// not rescues or refinements). One thread: the designs are solved side by side, and a
+/// solve's result does not depend on its thread count.
 fn trial_solve(plan: &Plan, file: &Path, name: &str, seed: u64) -> Result<Solved> {
     let json = plan.scene_json(name, SCRATCH_TARGET, seed);
     files::write_atomic(file, serde_json::to_string_pretty(&json)?.as_bytes())?;
@@ -733,6 +733,7 @@ fn trial_solve(plan: &Plan, file: &Path, name: &str, seed: u64) -> Result<Solved
     let options = SolveOptions {
         threads: Some(1),
         skip_trades: true,
+        skip_polish: true,
         ..SolveOptions::default()
     };
     let (solution, _) = solver::solve(&problem, &options, &mut Silent, &INTERRUPTS);

@@ -321,6 +321,7 @@ fn solve_into(
         seed,
         resume: resume_from,
         skip_trades: false,
+        skip_polish: false,
     };
     clock.lap("resume and output folder");
     let first_stage = options.resume.as_ref().map_or(0, |s| s.stages_completed);

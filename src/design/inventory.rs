@@ -146,7 +146,10 @@ fn positive(x: f64, what: &str) -> Result<f64, String> {
     if x.is_finite() && x > 0.0 && x <= 1e3 {
         Ok(x)
     } else {
-        Err(format!("{what} must be positive and at most 1000, got {x}"))
+        Err(format!(
+            "{what} must be positive and at most 1000, got {}",
+            crate::scene::short(x)
+        ))
     }
 }
 
@@ -162,7 +165,10 @@ fn add(
         Some(d) if !(d.is_finite() && d > 0.0 && d <= 1e5) => {
             return Err(bad(
                 "density",
-                format!("density must be positive and at most 100000 kg/m^3, got {d}"),
+                format!(
+                    "density must be positive and at most 100000 kg/m^3, got {}",
+                    crate::scene::short(d)
+                ),
             ))
         }
         Some(d) => d,

@@ -78,7 +78,7 @@ impl Validator<'_> {
         if x > 0.0 {
             Ok(x)
         } else {
-            Err(self.field_err(field, format!("must be positive, got {x}")))
+            Err(self.field_err(field, format!("must be positive, got {}", short(x))))
         }
     }
 
@@ -87,7 +87,7 @@ impl Validator<'_> {
         if x >= 0.0 {
             Ok(x)
         } else {
-            Err(self.field_err(field, format!("must not be negative, got {x}")))
+            Err(self.field_err(field, format!("must not be negative, got {}", short(x))))
         }
     }
 

@@ -35,6 +35,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 use crate::geometry::shape::Shape;
+use crate::scene::short;
 
 /// Air density at 20 C and sea level (kg/m^3).
 pub const AIR_DENSITY: f64 = 1.204;
@@ -85,13 +86,13 @@ impl Default for DragConfig {
 /// Why a [`DragConfig`] was refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum DragError {
-    #[error("air density must be between 0 and {MAX_DENSITY} kg/m^3, got {0}")]
+    #[error("air density must be between 0 and {MAX_DENSITY} kg/m^3, got {}", short(*.0))]
     Density(f64),
     #[error(
-        "the drag coefficient of {shape} must be between 0 and {MAX_COEFFICIENT}, got {value}"
+        "the drag coefficient of {shape} must be between 0 and {MAX_COEFFICIENT}, got {}", short(*.value)
     )]
     Coefficient { shape: &'static str, value: f64 },
-    #[error("the integrator step must be positive and at most 0.1 s, got {0}")]
+    #[error("the integrator step must be positive and at most 0.1 s, got {}", short(*.0))]
     Step(f64),
 }
 

@@ -795,6 +795,8 @@ fn budget_prints_tiny_and_huge_numbers_in_exponent_form() {
     for (flag, says) in [
         ("--iou-threshold", "at most 1, got 1e300"),
         ("--speed-tol", "between 0 and 50 %, got 1e300"),
+        ("--rho", "kg/m^3, got 1e300"),
+        ("--cd", "between 0 and 10, got 1e300"),
     ] {
         let (ok, _, err) = bsa(&["budget", dir, flag, "1e300", "-q"]);
         assert!(!ok && err.contains(says) && !digits(&err), "{flag}: {err}");

@@ -273,6 +273,8 @@ fn new_refuses_pictures_objects_and_options_it_cannot_use() {
         (m, "sphere:1e-9", vec![], "less than one pixel"),
         (m, "mesh:Cargo.toml", vec![], "--objects: mesh:"),
         (m, "cube:1", vec![], "unknown kind `cube`"),
+        (m, "box:1e300x1x1", vec![], "at most 1000, got 1e300"),
+        (m, "sphere:0.1/-1e300", vec![], "kg/m^3, got -1e300"),
         (
             m,
             "mesh:/nonexistent/piece.obj",
@@ -511,16 +513,27 @@ fn new_keeps_the_design_that_solves_best_and_solve_ends_where_its_trial_did() {
     let at = ceilings.iter().position(|&c| c == ceiling).unwrap();
     let kept = orders.iter().find(|o| o.0 == order).unwrap().1[at];
     assert_eq!(kept, Some(best), "{out}");
-    // The written scene is the design that was tried: its solve ends where the trial did
-    // (the trials leave out the last stage's trades, and fly's solve takes none).
+    // The written scene is the design that was tried: its solve's last stage ends where
+    // the trial did, and its polish (which the trials leave out, with the trades; fly's
+    // solve takes none) goes on from there to a picture no worse.
     let solved = d.join("out");
     solve(&dir, &solved, &[]);
     let solution = read_json(&solved.join("solution.json"));
     let iou = solution["iou"].as_f64().unwrap();
+    let stages = solution["stages"].as_array().unwrap();
+    let stop = stages.last().unwrap()["stop"].as_str().unwrap();
+    let polished: Vec<f64> = stop
+        .split("polished ")
+        .nth(1)
+        .and_then(|s| s.split(", IoU ").nth(1))
+        .map(|s| s.split(" to ").filter_map(|x| x.parse().ok()).collect())
+        .unwrap_or_else(|| panic!("no polish in `{stop}`"));
+    assert_eq!(polished.len(), 2, "{stop}");
     assert!(
-        (iou - best).abs() < 1e-4,
-        "solve {iou}, trial {best}: {out}"
+        (polished[0] - best).abs() < 1e-4 && (polished[1] - iou).abs() < 1e-4,
+        "solve {iou} ({stop}), trial {best}: {out}"
     );
+    assert!(iou >= best, "solve {iou}, trial {best}");
     // The example in scenes/fly is this design, byte for byte: the examples come from
     // `bsa new`, and a change of the design shows here until they are made again.
     let designed = std::fs::read_to_string(dir.join("scene.json")).unwrap();
