@@ -279,6 +279,9 @@ pub fn solve(
         }
     }
 
+    // The scene's last stage of one body: the settings of the one-body runs that refine
+    // exchanges, trades and the last stage's polish.
+    let one_body = scene.stages.iter().rev().find(|s| s.vary.len() == 1);
     for (k, stage) in scene.stages.iter().enumerate().skip(first_stage) {
         if interrupts.load(Ordering::SeqCst) >= 2 {
             aborted = true;
@@ -377,8 +380,7 @@ pub fn solve(
                 // its pieces are searched (`trade_trials`). The first that does is
                 // taken, and the stage goes on from it as after a trade taken.
                 let kept = rank_value(&best_eval, scene.contacts);
-                let template = scene.stages.iter().rev().find(|s| s.vary.len() == 1);
-                let (better, used) = match template {
+                let (better, used) = match one_body {
                     Some(template) => trade_trials(
                         problem,
                         &pool,
@@ -407,8 +409,7 @@ pub fn solve(
             }
             // Exchanges of two bodies' poses and places, each refined by rounds of
             // one-body runs, before the stage's first run (see `exchange`).
-            let template = scene.stages.iter().rev().find(|s| s.vary.len() == 1);
-            if let Some(template) = template.filter(|_| restart == 0 && !traded && !robust) {
+            if let Some(template) = one_body.filter(|_| restart == 0 && !traded && !robust) {
                 // What the solve drew before this stage, and the stage so far.
                 let drawn = reports.iter().map(|r| r.samples).sum::<usize>() + samples;
                 let better = exchange(
@@ -543,14 +544,13 @@ pub fn solve(
             population = 2 * pop;
             observer.restarted(k, restart, population);
         };
-        let template = scene.stages.iter().rev().find(|s| s.vary.len() == 1);
         let polishes = k + 1 == scene.stages.len()
             && !options.skip_polish
             && !interrupted
             && !robust
             && stage.vary.len() > 1
             && best_eval.iou < stage.restart_iou;
-        if let Some(template) = template.filter(|_| polishes) {
+        if let Some(template) = one_body.filter(|_| polishes) {
             // Judged without the hints: they say where the design sent each body, and on
             // its own part a hint's pull holds a piece's outline a fraction of a pixel
             // off (see `polish`). The stage's report keeps the weights it ran with.
