@@ -366,6 +366,7 @@ pub fn solve(
                     },
                     polish_single: restart > 0 || stage.vary.len() > 1,
                     trades: trading,
+                    seat_blocks: false,
                 },
                 &mut ws,
                 &mut |e: &Evaluation| records.push(sample_record(k, iteration, stage, e)),
@@ -556,7 +557,7 @@ pub fn solve(
             // off (see `polish`). The stage's report keeps the weights it ran with.
             let before = best_eval.iou;
             best_eval = problem.evaluate_held(&held, &best_params, &unhinted.weights, &mut ws);
-            let (used, moved) = polish(
+            let (used, seated, moved) = polish(
                 problem,
                 &pool,
                 &held,
@@ -572,7 +573,7 @@ pub fn solve(
             best_eval = problem.evaluate_held(&held, &best_params, &ran.weights, &mut ws);
             best_mask.copy_from(&ws.mask);
             polish_text = Some(format!(
-                "; polished {moved} of {} bodies, IoU {before:.4} to {:.4}",
+                "; moves taken: {seated}, polished {moved} of {} bodies, IoU {before:.4} to {:.4}",
                 stage.vary.len(),
                 best_eval.iou
             ));
@@ -805,12 +806,14 @@ fn trade_trials(
 /// The step of the polish's runs, a share of the one-body stage's step.
 const POLISH_STEP_SHARE: f64 = 0.1;
 
-/// The last stage's polish: each of its bodies in turn, the others held, refined by one
-/// CMA-ES run with the settings of `template` (the scene's last stage of one body) but a
-/// tenth of its step ([`POLISH_STEP_SHARE`]), from the best launch so far (`best`: the
-/// launch and its evaluation under `stage`'s weights). A run's end is kept when it ranks
-/// better and draws no worse a picture; `best` is updated in place. Returns the samples
-/// drawn and the bodies moved.
+/// The last stage's polish: first the moves with every block seated anew on its own
+/// place (`moves::improve` with `seat_blocks`), then each of the stage's bodies in turn,
+/// the others held, refined by one CMA-ES run with the settings of `template` (the
+/// scene's last stage of one body) but a tenth of its step ([`POLISH_STEP_SHARE`]), from
+/// the best launch so far (`best`: the launch and its evaluation under `stage`'s
+/// weights). The moves' end and each run's are kept when they rank better and draw no
+/// worse a picture; `best` is updated in place. Returns the samples drawn, the moves
+/// taken and the bodies the runs moved.
 ///
 /// A joint stage of many bodies stops at its iteration cap still short of a pixel's
 /// precision: its step shrinks slowly over 36 dimensions and more (on the planted chess
@@ -834,9 +837,10 @@ fn polish(
     seed: u64,
     ws: &mut Workspace,
     record: &mut dyn FnMut(&Evaluation),
-) -> (usize, usize) {
+) -> (usize, usize, usize) {
     let contacts = problem.scene.contacts;
-    let (mut samples, mut moved) = (0, 0);
+    let (mut samples, seated) = polish_moves(problem, held, stage, params, best, ws, record);
+    let mut moved = 0;
     for (g, &body) in stage.vary.iter().enumerate() {
         let run = Stage {
             vary: vec![body],
@@ -857,7 +861,56 @@ fn polish(
             moved += 1;
         }
     }
-    (samples, moved)
+    (samples, seated, moved)
+}
+
+/// The polish's first step: the moves of `stage`'s bodies from `params` (evaluated as
+/// `best`, both updated in place), every block seated anew on its own place in every
+/// pass (`seat_blocks`). Returns the samples drawn and the moves taken (none when
+/// their end drew a worse picture, which is then not kept).
+///
+/// A block tilted the other way, or on another face, draws an outline near its part's
+/// that no run of small steps leaves (the planted boxes 11204: one block's outline off
+/// all round, IoU 0.9916, where its seat draws 0.9997); in a cluster, one block seated
+/// anew lets the next find its pose. Run before the runs of one body rather than after
+/// them: the runs then refine the seated blocks (on 14 planted block problems, after
+/// the runs it gained less: 0.9981 against 0.9997 on boxes 11204).
+fn polish_moves(
+    problem: &Problem,
+    held: &Held,
+    stage: &Stage,
+    params: &mut [f64],
+    best: &mut Evaluation,
+    ws: &mut Workspace,
+    record: &mut dyn FnMut(&Evaluation),
+) -> (usize, usize) {
+    let contacts = problem.scene.contacts;
+    let rank = |e: &Evaluation| rank_value(e, contacts);
+    let (kept, kept_eval) = (params.to_vec(), *best);
+    let seats = moves::improve(
+        problem,
+        held,
+        &stage.vary,
+        &stage.weights,
+        &rank,
+        params,
+        best,
+        moves::MoveOptions {
+            max_moves: stage.vary.len(),
+            polish_single: true,
+            trades: false,
+            seat_blocks: true,
+        },
+        ws,
+        record,
+    );
+    let (samples, mut seated) = (seats.samples, seats.accepted);
+    if best.iou < kept_eval.iou {
+        params.copy_from_slice(&kept);
+        *best = kept_eval;
+        seated = 0;
+    }
+    (samples, seated)
 }
 
 /// One CMA-ES run of `run` (its bodies, step, population, iteration cap and stagnation)

@@ -331,6 +331,12 @@ pub struct MoveOptions {
     /// meshes of different shapes among at most [`MAX_MESH_TRADES`] ordered pairs)
     /// moves nothing.
     pub trades: bool,
+    /// Seat the blocks on their own places too, as the meshes are, in every pass (a
+    /// block tilted the wrong way, its outline near its part's). The last stage's polish
+    /// asks for it; the stages' calls do not: there it lowered as many planted block
+    /// problems as it raised (a seat taken early leaves a block's part to the runs after
+    /// it in a pose that is not yet its own).
+    pub seat_blocks: bool,
 }
 
 /// Greedy moves of the occluders in `vary` from `params` (the launch of every
@@ -603,10 +609,12 @@ pub fn improve(
             }
         }
         // Seat the meshes (`seat_pose`), in the first pass only (in every pass of a call
-        // that trades: a trade of two often leaves a third body to seat): a scan of every
-        // pose costs a few thousand shadows of one body, and a seat that the first pass
-        // did not take is rarely taken after a smaller move.
-        if pass == 0 || options.trades {
+        // that trades: a trade of two often leaves a third body to seat; and of a call
+        // that seats the blocks: in a cluster of blocks, one seated anew lets the next
+        // find its own pose): a scan of every pose costs a few thousand shadows of one
+        // body, and a seat that the first pass did not take is rarely taken after a
+        // smaller move.
+        if pass == 0 || options.trades || options.seat_blocks {
             let seats = Seats {
                 problem,
                 held,
@@ -633,7 +641,13 @@ pub fn improve(
                     offer(&candidate, &bodies, search, ws);
                 };
             // Each on its own place ...
-            for &i in &meshes {
+            // (the blocks too where the caller asks) ...
+            let own: Vec<usize> = if options.seat_blocks {
+                meshes.iter().chain(&blocks).copied().collect()
+            } else {
+                meshes.clone()
+            };
+            for &i in &own {
                 if let Some((cost, pose)) = seats.own(i, ws) {
                     if cost < wrong {
                         offer_seats(&[(i, pose)], &mut search, ws);
