@@ -630,7 +630,7 @@ fn the_last_stage_trades_pieces_that_the_hints_hold_each_on_another_part() {
     // with its last stage to run again (IoU 0.9605): the queen on the king's part, the
     // king on the bishop's, the bishop on the queen's, each where its hint points. Judged
     // with the hints, no trade is better (they add 183 pixels to the 354 wrong ones).
-    let (iou, contacts) = last_stage_again("chess-cycle");
+    let (iou, contacts, _) = last_stage_again("chess-cycle");
     // 0.9735 when written: the king and the bishop traded.
     assert!(iou > 0.97, "IoU {iou}");
     assert_eq!(contacts, 0);
@@ -638,15 +638,17 @@ fn the_last_stage_trades_pieces_that_the_hints_hold_each_on_another_part() {
 
 /// `bsa solve --resume` of the fixture `tests/fixtures/<name>` from its `stuck.json` (a
 /// solve with its last stage to run again): the IoU it ends at and its contacts.
-fn last_stage_again(name: &str) -> (f64, u64) {
+fn last_stage_again(name: &str) -> (f64, u64, String) {
     let scene = crate::util::root().join("tests/fixtures").join(name);
     let out = crate::util::tmpdir(name);
     std::fs::copy(scene.join("stuck.json"), out.join("solution.json")).unwrap();
     crate::util::solve(&scene, &out, &["--resume"]);
     let s = crate::util::read_json(&out.join("solution.json"));
+    let stages = s["stages"].as_array().unwrap();
     (
         s["iou"].as_f64().unwrap(),
         s["n_contacts"].as_u64().unwrap(),
+        stages.last().unwrap()["stop"].as_str().unwrap().to_string(),
     )
 }
 
@@ -657,7 +659,7 @@ fn a_trade_of_pieces_worse_as_seated_is_searched_and_mends_a_cluster() {
     // the bishop and the knight each hold another's place. Every trade draws a worse
     // picture as seated (the one that mends it 1.6 times the energy kept), so none was
     // taken; searched (`trade_trials`), that one is.
-    let (iou, contacts) = last_stage_again("chess-cluster");
+    let (iou, contacts, _) = last_stage_again("chess-cluster");
     // 0.9719 when written (0.9569 before the trials).
     assert!(iou > 0.97, "IoU {iou}");
     assert_eq!(contacts, 0);
@@ -670,17 +672,11 @@ fn the_last_stage_polishes_each_piece_to_its_outline() {
     // a few wrong pixels along every outline, where the joint stage's runs find nothing
     // better. The polish, one piece at a time with a tenth of the one-piece stages' step,
     // mends them.
-    let scene = crate::util::root().join("tests/fixtures/chess-outline");
-    let out = crate::util::tmpdir("chess-outline");
-    std::fs::copy(scene.join("stuck.json"), out.join("solution.json")).unwrap();
-    crate::util::solve(&scene, &out, &["--resume"]);
-    let s = crate::util::read_json(&out.join("solution.json"));
-    let iou = s["iou"].as_f64().unwrap();
-    let stop = s["stages"][24]["stop"].as_str().unwrap();
+    let (iou, contacts, stop) = last_stage_again("chess-outline");
     // 0.9909 when written, 4 pieces of 6 moved.
     assert!(iou > 0.989, "IoU {iou}; {stop}");
     assert!(stop.contains("polished"), "{stop}");
-    assert_eq!(s["n_contacts"].as_u64().unwrap(), 0);
+    assert_eq!(contacts, 0);
 }
 
 #[test]
@@ -690,17 +686,11 @@ fn the_last_stage_seats_a_block_tilted_the_wrong_way() {
     // round, tilted the other way, where runs of small steps (the joint stage's and the
     // polish's of one body) find nothing better. The polish's moves seat every block
     // anew on its own place and mend it.
-    let scene = crate::util::root().join("tests/fixtures/block-seat");
-    let out = crate::util::tmpdir("block-seat");
-    std::fs::copy(scene.join("stuck.json"), out.join("solution.json")).unwrap();
-    crate::util::solve(&scene, &out, &["--resume"]);
-    let s = crate::util::read_json(&out.join("solution.json"));
-    let iou = s["iou"].as_f64().unwrap();
-    let stop = s["stages"][4]["stop"].as_str().unwrap();
+    let (iou, contacts, stop) = last_stage_again("block-seat");
     // 0.9997 when written (0.9916 without the seats), one move taken.
     assert!(iou > 0.995, "IoU {iou}; {stop}");
     assert!(stop.contains("moves taken: 1"), "{stop}");
-    assert_eq!(s["n_contacts"].as_u64().unwrap(), 0);
+    assert_eq!(contacts, 0);
 }
 
 #[test]
