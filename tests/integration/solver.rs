@@ -637,7 +637,8 @@ fn the_last_stage_trades_pieces_that_the_hints_hold_each_on_another_part() {
 }
 
 /// `bsa solve --resume` of the fixture `tests/fixtures/<name>` from its `stuck.json` (a
-/// solve with its last stage to run again): the IoU it ends at and its contacts.
+/// solve with its last stage to run again): the IoU it ends at, its contacts and its
+/// last stage's `stop` text.
 fn last_stage_again(name: &str) -> (f64, u64, String) {
     let scene = crate::util::root().join("tests/fixtures").join(name);
     let out = crate::util::tmpdir(name);

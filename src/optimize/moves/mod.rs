@@ -52,7 +52,8 @@
 //!   scanned, the best [`SEAT_PAIRS`] refined): a piece on a wrong
 //!   face, or a king and a queen on each other's parts in poses no quarter or half turn
 //!   reaches, is a flat valley of the image energy that no local step and no other move
-//!   leaves.
+//!   leaves. A call that asks for it ([`MoveOptions::seat_blocks`], the last stage's
+//!   polish) seats every block on its own place too, and seats in every pass.
 //! - **split** a part between a hidden block and another, in the first pass of a call
 //!   too ([`Seats::splits`](pose::Seats::splits)): a block whose shadow adds fewer
 //!   than [`HIDDEN`](pose::HIDDEN) of its pixels to the picture (hidden under the
