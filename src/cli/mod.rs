@@ -121,6 +121,11 @@ struct SolveArgs {
     /// Worker threads, 1 to 256 [default: one per core].
     #[arg(long)]
     threads: Option<usize>,
+    /// Attempts at most, 1 to 16: while the picture ends below the last stage's
+    /// restart_iou, the stages run again from the start guess with another seed, and the
+    /// best picture is kept [default: 2].
+    #[arg(long)]
+    attempts: Option<usize>,
     /// Continue from the output folder's solution.json (skips its completed stages).
     #[arg(long)]
     resume: bool,

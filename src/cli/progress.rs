@@ -62,6 +62,8 @@ pub(super) struct SolveProgress {
     stages_total: usize,
     /// Iteration cap of one run of the current stage (a restart adds as many again).
     run_length: u64,
+    /// The attempt running (0: the first), which later attempts' bars and lines name.
+    attempt: usize,
 }
 
 impl SolveProgress {
@@ -89,6 +91,7 @@ impl SolveProgress {
             // In the past, so that the first iteration already writes a preview.
             last_preview: Instant::now() - Duration::from_secs(1),
             stages_total: scene.stages.len(),
+            attempt: 0,
         })
     }
 
@@ -116,12 +119,32 @@ impl Observer for SolveProgress {
             self.quiet,
         );
         bar.set_prefix(format!(
-            "stage {}/{} {}",
+            "{}stage {}/{} {}",
+            self.attempt_prefix(),
             index + 1,
             self.stages_total,
             stage.name
         ));
         self.bar = Some(bar);
+    }
+
+    fn attempt_started(&mut self, attempt: usize, attempts: usize, kept: &Solution, seed: u64) {
+        self.attempt = attempt;
+        println!(
+            "attempt {}/{attempts}: the picture kept ends at IoU {:.4}{}, under the last stage's restart IoU; the stages again from the start guess, seed {seed} (the solution saved stays the best)",
+            attempt + 1,
+            kept.iou,
+            if kept.n_contacts > 0 { " with a contact" } else { "" },
+        );
+    }
+
+    fn attempt_stage_finished(&mut self, s: &Solution) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
+        }
+        if let Some(line) = stage_line(s) {
+            println!("{}{line}", self.attempt_prefix());
+        }
     }
 
     fn restarted(&mut self, _index: usize, restart: usize, population: usize) {
@@ -164,17 +187,8 @@ impl Observer for SolveProgress {
         // Stage lines are results, like the summary that follows them: both go to stdout,
         // so that they arrive in order wherever stdout and stderr are sent (the bars
         // stay on stderr).
-        if let Some(r) = s.stages.last() {
-            println!(
-                "stage {}/{} `{}`: {} iterations, {} samples{}, best energy {:.4e}, IoU {:.4}, {:.2} s ({})",
-                s.stages_completed, s.stages_total, r.name, r.iterations, r.samples,
-                match r.restarts {
-                    0 => String::new(),
-                    1 => ", 1 restart".to_string(),
-                    n => format!(", {n} restarts"),
-                },
-                r.best_energy, r.iou, r.wall_time_s, r.stop
-            );
+        if let Some(line) = stage_line(s) {
+            println!("{line}");
         }
         // `records` is every record of this run so far: only the new ones are handed over.
         self.writer.send(Job::Stage {
@@ -182,6 +196,39 @@ impl Observer for SolveProgress {
             solution: Box::new(s.clone()),
         });
         self.encoded = records.len();
+    }
+}
+
+/// The line of the last stage of `s`: its iterations, samples, restarts, energy, IoU,
+/// time and why it stopped.
+fn stage_line(s: &Solution) -> Option<String> {
+    let r = s.stages.last()?;
+    Some(format!(
+        "stage {}/{} `{}`: {} iterations, {} samples{}, best energy {:.4e}, IoU {:.4}, {:.2} s ({})",
+        s.stages_completed,
+        s.stages_total,
+        r.name,
+        r.iterations,
+        r.samples,
+        match r.restarts {
+            0 => String::new(),
+            1 => ", 1 restart".to_string(),
+            n => format!(", {n} restarts"),
+        },
+        r.best_energy,
+        r.iou,
+        r.wall_time_s,
+        r.stop
+    ))
+}
+
+impl SolveProgress {
+    /// "attempt N: " during a later attempt, nothing during the first.
+    fn attempt_prefix(&self) -> String {
+        match self.attempt {
+            0 => String::new(),
+            a => format!("attempt {}: ", a + 1),
+        }
     }
 }
 

@@ -32,6 +32,8 @@ pub(super) struct Options {
     seed: Option<u64>,
     /// Between 1 and [`MAX_THREADS`] when given.
     threads: Option<usize>,
+    /// Between 1 and [`MAX_ATTEMPTS`].
+    attempts: usize,
     resume: bool,
     /// Replace another scene's results in the output folder.
     force: bool,
@@ -44,6 +46,9 @@ pub(super) struct Options {
     robust: Option<Robust>,
     free_positions: bool,
 }
+
+/// The most attempts `--attempts` accepts.
+const MAX_ATTEMPTS: usize = 16;
 
 /// Perturbed launches per sample of `--robust` unless `--draws` says otherwise.
 const DEFAULT_DRAWS: usize = 16;
@@ -60,6 +65,10 @@ impl Options {
             if !(1..=MAX_THREADS).contains(&n) {
                 bail!("--threads must be between 1 and {MAX_THREADS}, got {n}");
             }
+        }
+        let attempts = args.attempts.unwrap_or(solver::DEFAULT_ATTEMPTS);
+        if !(1..=MAX_ATTEMPTS).contains(&attempts) {
+            bail!("--attempts must be between 1 and {MAX_ATTEMPTS}, got {attempts}");
         }
         let tolerances = [
             ("--speed-tol", args.speed_tol),
@@ -131,6 +140,7 @@ impl Options {
             out: args.out,
             seed: args.seed,
             threads: args.threads,
+            attempts,
             resume: args.resume,
             force: args.force,
             report: args.report,
@@ -322,6 +332,7 @@ fn solve_into(
         resume: resume_from,
         skip_trades: false,
         skip_polish: false,
+        attempts: opts.attempts,
     };
     clock.lap("resume and output folder");
     let first_stage = options.resume.as_ref().map_or(0, |s| s.stages_completed);
@@ -394,6 +405,26 @@ fn solve_into(
         solution.threads,
         if solution.complete { "" } else { " (stopped early)" }
     );
+    if solution.attempts.len() > 1 {
+        let each: Vec<String> = solution
+            .attempts
+            .iter()
+            .map(|a| {
+                format!(
+                    "seed {} IoU {:.4}{}{}",
+                    a.seed,
+                    a.iou,
+                    if a.n_contacts > 0 {
+                        " with a contact"
+                    } else {
+                        ""
+                    },
+                    if a.kept { " (kept)" } else { "" }
+                )
+            })
+            .collect();
+        println!("{} attempts: {}", solution.attempts.len(), each.join(", "));
+    }
     println!(
         "wrote {}/{{solution.json, convergence.csv, convergence.png, convergence.svg, shadow.png, overlay.png, preview.png{}}}",
         out.display(),

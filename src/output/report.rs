@@ -103,6 +103,33 @@ pub fn report_html(dir: &Path, s: &Solution) -> Result<String, ExportError> {
         threads = s.threads,
         seed = s.seed,
     );
+    if s.attempts.len() > 1 {
+        // A solve of several attempts: each one's picture, and which is shown.
+        let each: Vec<String> = s
+            .attempts
+            .iter()
+            .map(|a| {
+                format!(
+                    "seed {} IoU {:.4}{}, {:.2} s{}",
+                    a.seed,
+                    a.iou,
+                    if a.n_contacts > 0 {
+                        " with a contact"
+                    } else {
+                        ""
+                    },
+                    a.wall_time_s,
+                    if a.kept { " (shown)" } else { "" }
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            h,
+            "<p>{} attempts from the start guess: {}.</p>",
+            s.attempts.len(),
+            esc(&each.join("; "))
+        );
+    }
     for (file, title) in PICTURES {
         if let Some(bytes) = read_optional(&dir.join(file))? {
             let _ = writeln!(h, "<h2>{title}</h2>\n{}", img_tag(&bytes, title));

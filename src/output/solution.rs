@@ -139,6 +139,23 @@ pub struct Solution {
     /// The launch errors of a robust solve (`bsa solve --robust`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub robust: Option<RobustRecord>,
+    /// Every attempt of a solve that ran more than one (`bsa solve --attempts`), in
+    /// order; empty after one. The launch, the stages and the energy are those of the
+    /// attempt kept; `samples`, `iterations` and `wall_time_s` count every attempt.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub attempts: Vec<AttemptRecord>,
+}
+
+/// One attempt of a solve (its stages from the start guess, with its own seed).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AttemptRecord {
+    pub seed: u64,
+    pub iou: f64,
+    pub n_contacts: u32,
+    pub samples: usize,
+    pub wall_time_s: f64,
+    /// Whether its launch is the solution's.
+    pub kept: bool,
 }
 
 impl Solution {

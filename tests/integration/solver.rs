@@ -34,6 +34,7 @@ fn same_seed_gives_bit_identical_solution_with_1_and_2_threads() {
             resume: None,
             skip_trades: false,
             skip_polish: false,
+            attempts: 1,
         };
         solver::solve(&p, &opts, &mut solver::Silent, &none)
     };
@@ -51,6 +52,7 @@ fn same_seed_gives_bit_identical_solution_with_1_and_2_threads() {
         resume: None,
         skip_trades: false,
         skip_polish: false,
+        attempts: 1,
     };
     let (_, rc) = solver::solve(&p, &opts, &mut solver::Silent, &none);
     assert_ne!(ra, rc);
@@ -74,6 +76,7 @@ fn resume_continues_to_the_same_result() {
         resume: None,
         skip_trades: false,
         skip_polish: false,
+        attempts: 1,
     };
     let none = AtomicUsize::new(0);
     let (full, _) = solver::solve(&p, &opts, &mut solver::Silent, &none);
@@ -118,6 +121,7 @@ fn a_stage_stopped_by_a_second_interrupt_runs_again_on_resume() {
         resume: None,
         skip_trades: false,
         skip_polish: false,
+        attempts: 1,
     };
     let (stopped, _) = solver::solve(&p, &opts, &mut StopMidFirstStage(&counter), &counter);
     assert_eq!(stopped.stages_completed, 0);
@@ -449,6 +453,7 @@ fn run_moves_trading(
             polish_single: true,
             trades,
             seat_blocks: false,
+            evolve_fits: false,
         },
         &mut ws,
         &mut |_| {},
@@ -643,7 +648,9 @@ fn last_stage_again(name: &str) -> (f64, u64, String) {
     let scene = crate::util::root().join("tests/fixtures").join(name);
     let out = crate::util::tmpdir(name);
     std::fs::copy(scene.join("stuck.json"), out.join("solution.json")).unwrap();
-    crate::util::solve(&scene, &out, &["--resume"]);
+    // One attempt: what the last stage does, not what a second attempt from the start
+    // guess would.
+    crate::util::solve(&scene, &out, &["--resume", "--attempts", "1"]);
     let s = crate::util::read_json(&out.join("solution.json"));
     let stages = s["stages"].as_array().unwrap();
     (
@@ -688,10 +695,84 @@ fn the_last_stage_seats_a_block_tilted_the_wrong_way() {
     // polish's of one body) find nothing better. The polish's moves seat every block
     // anew on its own place and mend it.
     let (iou, contacts, stop) = last_stage_again("block-seat");
-    // 0.9997 when written (0.9916 without the seats), one move taken.
+    // 0.9997 when written (0.9916 without the seats), one move taken (two since the
+    // fits evolve: the seat, then a fit).
     assert!(iou > 0.995, "IoU {iou}; {stop}");
-    assert!(stop.contains("moves taken: 1"), "{stop}");
+    assert!(
+        stop.contains("moves taken: ") && !stop.contains("moves taken: 0"),
+        "{stop}"
+    );
     assert_eq!(contacts, 0);
+}
+
+#[test]
+fn the_last_stage_evolves_a_block_fit_along_a_valley_of_its_pose() {
+    // The planted mix seed 11402 (two spheres, two long blocks) as `bsa new` designed
+    // it, and its solve with the last stage to run again (IoU 0.9896): a block's outline
+    // a pixel or two off its part, where every move of the compass search of its pose
+    // alone (a turn, a shift, a change of depth) costs pixels. The polish's fits then
+    // search all six at once by CMA-ES.
+    let (iou, contacts, stop) = last_stage_again("block-evolve");
+    // 1.0000 when written (0.9921 with the compass alone).
+    assert!(iou > 0.999, "IoU {iou}; {stop}");
+    assert_eq!(contacts, 0);
+}
+
+/// Mickey, each stage cut to a few iterations: a solve that ends far below its target.
+fn short_mickey(name: &str) -> crate::util::TempDir {
+    variant(name, |v| {
+        for s in v["stages"].as_array_mut().unwrap() {
+            s["max_iterations"] = 3.into();
+            s["population"] = 8.into();
+        }
+    })
+}
+
+#[test]
+fn a_second_attempt_runs_below_the_target_and_keeps_the_better_picture() {
+    let d = short_mickey("attempts");
+    let one = d.join("one");
+    let two = d.join("two");
+    crate::util::solve(&d, &one, &["--attempts", "1"]);
+    let text = crate::util::solve(&d, &two, &[]);
+    let (s1, s2) = (
+        crate::util::read_json(&one.join("solution.json")),
+        crate::util::read_json(&two.join("solution.json")),
+    );
+    // One attempt: no record of attempts.
+    assert!(s1.get("attempts").is_none(), "{s1}");
+    let tried = s2["attempts"].as_array().expect("attempts recorded");
+    assert_eq!(tried.len(), 2, "{text}");
+    assert!(text.contains("attempt 2/2"), "{text}");
+    // The first attempt is the solve of one attempt, bit for bit.
+    assert_eq!(tried[0]["iou"].as_f64(), s1["iou"].as_f64());
+    assert_eq!(tried[0]["seed"].as_u64(), s1["seed"].as_u64());
+    assert_ne!(tried[1]["seed"].as_u64(), tried[0]["seed"].as_u64());
+    // Exactly one kept, the better picture, and it is the solution's.
+    let kept: Vec<usize> = (0..2).filter(|&k| tried[k]["kept"] == true).collect();
+    assert_eq!(kept.len(), 1, "{s2}");
+    let iou = |k: usize| tried[k]["iou"].as_f64().unwrap();
+    assert_eq!(iou(kept[0]), iou(0).max(iou(1)));
+    assert_eq!(s2["iou"].as_f64().unwrap(), iou(kept[0]));
+    // Samples count both attempts, and so does the convergence table.
+    let samples: u64 = tried.iter().map(|t| t["samples"].as_u64().unwrap()).sum();
+    assert_eq!(s2["samples"].as_u64().unwrap(), samples);
+    let rows = std::fs::read_to_string(two.join("convergence.csv"))
+        .unwrap()
+        .lines()
+        .count()
+        - 1;
+    assert_eq!(rows as u64, samples);
+}
+
+#[test]
+fn attempts_out_of_range_are_refused_by_name() {
+    let d = short_mickey("attempts-bad");
+    for bad in ["0", "17"] {
+        let (ok, _, err) = crate::util::bsa(&["solve", d.to_str().unwrap(), "--attempts", bad]);
+        assert!(!ok);
+        assert!(err.contains("--attempts must be between 1 and 16"), "{err}");
+    }
 }
 
 #[test]

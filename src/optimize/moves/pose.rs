@@ -13,6 +13,7 @@ use super::spin::{launch_to, spin_guesses};
 use super::{allowed_depth, lowest_centre, Sight, MIN_DEPTH, REVOLUTION};
 use crate::evaluate::{Held, Problem, Workspace};
 use crate::geometry::shape::Shape;
+use crate::optimize::cmaes::{Cmaes, CmaesConfig};
 use crate::scene::Launch;
 use crate::shadow::mask::Mask;
 use crate::sim::flight::FreeFlight;
@@ -29,6 +30,14 @@ pub(super) const POSE_TURN: f64 = 0.1;
 pub(super) const POSE_SHIFT: f64 = 3.0;
 /// Change of depth (a fraction of it) of the first steps of [`fit_pose`].
 pub(super) const POSE_DEPTH: f64 = 0.03;
+/// The first step of [`Seat::evolve`], in units of the compass's first steps (0.03 rad,
+/// 0.9 pixel, 0.9 % of the depth).
+pub(super) const POSE_CMA_STEP: f64 = 0.3;
+/// Poses per generation of [`Seat::evolve`] (the default for six dimensions is 9).
+pub(super) const POSE_CMA_POPULATION: usize = 12;
+/// Generations of [`Seat::evolve`] at most, and without a gain before it stops.
+pub(super) const POSE_CMA_GENERATIONS: usize = 300;
+pub(super) const POSE_CMA_STAGNATION: usize = 40;
 /// Times [`fit_pose`] halves its steps; it sweeps each step size until a sweep gains
 /// nothing, at most [`POSE_SWEEPS`] times.
 pub(super) const POSE_LEVELS: usize = 5;
@@ -155,6 +164,66 @@ impl<'a> Seat<'a> {
         (best, com, q)
     }
 
+    /// A CMA-ES search from the pose `(com, q)`, whose cost is `start`, over the same
+    /// six moves as [`Seat::compass`] (turns about the world axes, shifts across the line
+    /// of sight, a change of depth, in units of the compass's first steps), all at once:
+    /// [`POSE_CMA_STEP`], [`POSE_CMA_POPULATION`], at most [`POSE_CMA_GENERATIONS`]
+    /// generations, stopped after [`POSE_CMA_STAGNATION`] without a gain. Returns the
+    /// best cost and pose (the start when nothing is better). Deterministic: its seed is
+    /// the body's index.
+    ///
+    /// Why: a block's outline a pixel or two off its part lies in a valley of the pixel
+    /// count along a combination of the moves (a turn and a shift and a change of depth
+    /// together, the outline's perspective kept), where every move alone costs pixels;
+    /// the compass stops there, CMA-ES learns the valley's direction.
+    fn evolve(
+        &self,
+        (com, q): (DVec3, DQuat),
+        start: i64,
+        ws: &mut Workspace,
+    ) -> (i64, DVec3, DQuat) {
+        let light = self.problem.scene.camera.light;
+        let sight = (com - light).normalize();
+        let e1 = sight.any_orthonormal_vector();
+        let e2 = sight.cross(e1);
+        let c = &self.problem.canvas;
+        let pixel = (c.pixel_to_world(1.0, 0.0) - c.pixel_to_world(0.0, 0.0)).length();
+        let shift = POSE_SHIFT * pixel * self.depth(com);
+        let pose = |y: &[f64]| {
+            let turn = DVec3::new(y[0], y[1], y[2]) * POSE_TURN;
+            let tq = (DQuat::from_scaled_axis(turn) * q).normalize();
+            let tc = com + e1 * (y[3] * shift) + e2 * (y[4] * shift);
+            (light + (tc - light) * (1.0 + y[5] * POSE_DEPTH), tq)
+        };
+        let config = CmaesConfig {
+            population: Some(POSE_CMA_POPULATION),
+            max_generations: POSE_CMA_GENERATIONS,
+            // Costs are whole pixels: any gain counts, and equal costs do not stop it.
+            tol_fun: 0.0,
+            stagnation_window: POSE_CMA_STAGNATION,
+            ..CmaesConfig::default()
+        };
+        let mut cma = Cmaes::new(&[0.0; 6], POSE_CMA_STEP, config, self.i as u64);
+        let mut best = (start, com, q);
+        let mut fitness = [0.0; POSE_CMA_POPULATION];
+        let mut trial = [0.0; 6 * POSE_CMA_POPULATION];
+        loop {
+            trial.copy_from_slice(cma.ask());
+            for (f, y) in fitness.iter_mut().zip(trial.chunks_exact(6)) {
+                let (tc, tq) = pose(y);
+                let cost = self.cost(tc, tq, ws);
+                *f = cost as f64;
+                if cost < best.0 {
+                    best = (cost, tc, tq);
+                }
+            }
+            cma.tell(&fitness);
+            if cma.stop().is_some() {
+                return best;
+            }
+        }
+    }
+
     /// The body turned to `q` and placed so that its shadow has about `area` pixels
     /// and its centroid at `centroid` (canvas pixels), from the depth `depth`: drawn
     /// twice to correct the depth (a shadow's area goes as the inverse square of the
@@ -191,7 +260,8 @@ impl<'a> Seat<'a> {
 /// A better pose at `t` for body `i`, searched on the pose itself: the shadow of the
 /// body at its pose in `ws.poses`, drawn over `others` (every other shadow), against the
 /// target, by a compass search over turns about the world axes, shifts across its line
-/// of sight and changes of depth ([`Seat::compass`]). A launch spin reaches an
+/// of sight and changes of depth ([`Seat::compass`]), then, when `thorough`, by CMA-ES
+/// over all of them at once ([`Seat::evolve`]). A launch spin reaches an
 /// orientation at `t` through the whole tumbling flight, where a small change of spin
 /// turns the body anywhere; a wrongly tilted block whose outline is near its part's is
 /// mended here in pixels, and the spin that reaches the pose is then solved for. Returns
@@ -201,6 +271,7 @@ pub(super) fn fit_pose(
     problem: &Problem,
     i: usize,
     others: &Mask,
+    thorough: bool,
     ws: &mut Workspace,
 ) -> Option<(DVec3, DQuat)> {
     let local = problem.scene.occluders[i].mass.local_com;
@@ -211,7 +282,10 @@ pub(super) fn fit_pose(
         return None;
     }
     let start = seat.cost(com0, q0, ws);
-    let (best, com, q) = seat.compass((com0, q0), start, (1.0, POSE_LEVELS), ws);
+    let (mut best, mut com, mut q) = seat.compass((com0, q0), start, (1.0, POSE_LEVELS), ws);
+    if thorough {
+        (best, com, q) = seat.evolve((com, q), best, ws);
+    }
     ws.poses[i] = (com - q * local, q);
     (best < start).then_some((com, q))
 }
@@ -661,7 +735,7 @@ pub(super) const MESH_TRADES: usize = 40;
 /// [`fit_pose`] body `i` (whose pose at `t` `ws.poses` holds, as for every body in
 /// `vary`) on the picture of the held bodies and the other bodies of `vary`, and launch
 /// it there in `candidate`: its spin by [`spin_reaching`](super::spin::spin_reaching)
-/// and its velocity by [`aim`](super::aim).
+/// and its velocity by [`aim`](super::aim); `thorough` as [`fit_pose`] takes it.
 /// `true` when it moved; otherwise `candidate` and its pose are unchanged.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn fit_and_launch(
@@ -670,6 +744,7 @@ pub(super) fn fit_and_launch(
     vary: &[bool],
     i: usize,
     candidate: &mut [f64],
+    thorough: bool,
     ws: &mut Workspace,
     flight: &mut FreeFlight,
 ) -> bool {
@@ -678,7 +753,7 @@ pub(super) fn fit_and_launch(
     problem.shadow_held_and(held, &which, ws);
     let others = ws.mask.clone();
     let kept = ws.poses[i];
-    let Some((com, q)) = fit_pose(problem, i, &others, ws) else {
+    let Some((com, q)) = fit_pose(problem, i, &others, thorough, ws) else {
         ws.poses[i] = kept;
         return false;
     };
