@@ -112,6 +112,19 @@ impl<'a> Seat<'a> {
             - s.and_count(&self.bare) as i64
     }
 
+    /// The light, two directions across the line of sight from it to `com`, and the
+    /// first step of a shift along them ([`POSE_SHIFT`] pixels of the shadow, in metres
+    /// at `com`): the frame of the pose searches' shifts and changes of depth.
+    fn axes(&self, com: DVec3) -> (DVec3, DVec3, DVec3, f64) {
+        let light = self.problem.scene.camera.light;
+        let sight = (com - light).normalize();
+        let e1 = sight.any_orthonormal_vector();
+        let e2 = sight.cross(e1);
+        let c = &self.problem.canvas;
+        let pixel = (c.pixel_to_world(1.0, 0.0) - c.pixel_to_world(0.0, 0.0)).length();
+        (light, e1, e2, POSE_SHIFT * pixel * self.depth(com))
+    }
+
     /// A compass search from the pose `(com, q)`, whose cost is `start`: turns about the
     /// world axes, shifts across the line of sight and changes of depth, first `first`
     /// times the steps [`POSE_TURN`], [`POSE_SHIFT`] and [`POSE_DEPTH`], halved `levels`
@@ -124,13 +137,7 @@ impl<'a> Seat<'a> {
         (first, levels): (f64, usize),
         ws: &mut Workspace,
     ) -> (i64, DVec3, DQuat) {
-        let light = self.problem.scene.camera.light;
-        let sight = (com - light).normalize();
-        let e1 = sight.any_orthonormal_vector();
-        let e2 = sight.cross(e1);
-        let c = &self.problem.canvas;
-        let pixel = (c.pixel_to_world(1.0, 0.0) - c.pixel_to_world(0.0, 0.0)).length();
-        let shift = POSE_SHIFT * pixel * self.depth(com);
+        let (light, e1, e2, shift) = self.axes(com);
         let (mut com, mut q, mut best) = (com, q, start);
         let mut h = first;
         for _ in 0..levels {
@@ -182,13 +189,7 @@ impl<'a> Seat<'a> {
         start: i64,
         ws: &mut Workspace,
     ) -> (i64, DVec3, DQuat) {
-        let light = self.problem.scene.camera.light;
-        let sight = (com - light).normalize();
-        let e1 = sight.any_orthonormal_vector();
-        let e2 = sight.cross(e1);
-        let c = &self.problem.canvas;
-        let pixel = (c.pixel_to_world(1.0, 0.0) - c.pixel_to_world(0.0, 0.0)).length();
-        let shift = POSE_SHIFT * pixel * self.depth(com);
+        let (light, e1, e2, shift) = self.axes(com);
         let pose = |y: &[f64]| {
             let turn = DVec3::new(y[0], y[1], y[2]) * POSE_TURN;
             let tq = (DQuat::from_scaled_axis(turn) * q).normalize();
