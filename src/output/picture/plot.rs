@@ -61,6 +61,8 @@ const PALETTE: [RGBColor; 10] = [
 ];
 const GRID: RGBColor = RGBColor(225, 225, 225);
 const STAGE_LINE: RGBColor = RGBColor(150, 150, 150);
+/// Where a later attempt of a solve starts (`bsa solve --attempts`).
+const ATTEMPT_LINE: RGBColor = RGBColor(40, 40, 40);
 
 fn font(size: u32) -> TextStyle<'static> {
     TextStyle::from(("sans-serif", size).into_font()).color(&BLACK_TEXT)
@@ -324,13 +326,32 @@ impl Draw for ConvergencePlot<'_> {
                 starts.push((r.stage, i));
             }
         }
+        // A solve of several attempts runs the stages again from the first: a stage
+        // number lower than the one before starts an attempt, drawn dark and named.
+        let mut attempt = 1;
         for (k, &(stage, i)) in starts.iter().enumerate() {
             let x = i as f64;
+            let again = k > 0 && stage < starts[k - 1].0;
             if k > 0 {
+                let (colour, width) = if again {
+                    (ATTEMPT_LINE, 3)
+                } else {
+                    (STAGE_LINE, 1)
+                };
                 chart
                     .draw_series(std::iter::once(PathElement::new(
                         [(x, f64::from(lo)), (x, f64::from(hi))],
-                        STAGE_LINE.stroke_width(1),
+                        colour.stroke_width(width),
+                    )))
+                    .map_err(e)?;
+            }
+            if again {
+                attempt += 1;
+                chart
+                    .draw_series(std::iter::once(Text::new(
+                        format!("attempt {attempt}"),
+                        (x + n * 0.004, f64::from(lo) + 0.05 * f64::from(hi - lo)),
+                        font(15),
                     )))
                     .map_err(e)?;
             }

@@ -124,6 +124,21 @@ fn convergence_plot_draws_png_and_svg_with_names_and_legend() {
 }
 
 #[test]
+fn a_later_attempt_of_a_solve_is_marked_where_its_stages_start_again() {
+    let mut data = sample_data();
+    assert!(!plot::convergence(&data).unwrap().svg.contains("attempt 2"));
+    // The same two stages again: a second attempt.
+    let again: Vec<ConvergenceRow> = data.rows.clone();
+    data.rows.extend(again);
+    let fig = plot::convergence(&data).unwrap();
+    assert!(
+        fig.svg.contains("attempt 2"),
+        "no marker of the second attempt"
+    );
+    assert!(!fig.svg.contains("attempt 3"));
+}
+
+#[test]
 fn convergence_plot_survives_non_finite_and_empty_data() {
     let mut data = sample_data();
     data.rows[3].total = f64::NAN;
