@@ -108,6 +108,14 @@ impl SolveProgress {
         self.writer.finish()?;
         Ok(start.elapsed())
     }
+
+    /// "attempt N: " during a later attempt, nothing during the first.
+    fn attempt_prefix(&self) -> String {
+        match self.attempt {
+            0 => String::new(),
+            a => format!("attempt {}: ", a + 1),
+        }
+    }
 }
 
 impl Observer for SolveProgress {
@@ -220,16 +228,6 @@ fn stage_line(s: &Solution) -> Option<String> {
         r.wall_time_s,
         r.stop
     ))
-}
-
-impl SolveProgress {
-    /// "attempt N: " during a later attempt, nothing during the first.
-    fn attempt_prefix(&self) -> String {
-        match self.attempt {
-            0 => String::new(),
-            a => format!("attempt {}: ", a + 1),
-        }
-    }
 }
 
 /// What the writer thread saves.

@@ -409,19 +409,7 @@ fn solve_into(
         let each: Vec<String> = solution
             .attempts
             .iter()
-            .map(|a| {
-                format!(
-                    "seed {} IoU {:.4}{}{}",
-                    a.seed,
-                    a.iou,
-                    if a.n_contacts > 0 {
-                        " with a contact"
-                    } else {
-                        ""
-                    },
-                    if a.kept { " (kept)" } else { "" }
-                )
-            })
+            .map(|a| format!("{}{}", a.describe(), if a.kept { " (kept)" } else { "" }))
             .collect();
         println!("{} attempts: {}", solution.attempts.len(), each.join(", "));
     }

@@ -109,18 +109,8 @@ pub fn report_html(dir: &Path, s: &Solution) -> Result<String, ExportError> {
             .attempts
             .iter()
             .map(|a| {
-                format!(
-                    "seed {} IoU {:.4}{}, {:.2} s{}",
-                    a.seed,
-                    a.iou,
-                    if a.n_contacts > 0 {
-                        " with a contact"
-                    } else {
-                        ""
-                    },
-                    a.wall_time_s,
-                    if a.kept { " (shown)" } else { "" }
-                )
+                let shown = if a.kept { " (shown)" } else { "" };
+                format!("{}, {:.2} s{shown}", a.describe(), a.wall_time_s)
             })
             .collect();
         let _ = writeln!(

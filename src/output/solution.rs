@@ -158,6 +158,19 @@ pub struct AttemptRecord {
     pub kept: bool,
 }
 
+impl AttemptRecord {
+    /// "seed N IoU 0.xxxx", and " with a contact" when it had one: how the summary line
+    /// of `bsa solve` and the report page name an attempt.
+    pub fn describe(&self) -> String {
+        let contact = if self.n_contacts > 0 {
+            " with a contact"
+        } else {
+            ""
+        };
+        format!("seed {} IoU {:.4}{contact}", self.seed, self.iou)
+    }
+}
+
 impl Solution {
     /// The launch values as the solver's parameter vector (6 per occluder).
     pub fn parameters(&self) -> Vec<f64> {
