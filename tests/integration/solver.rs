@@ -718,6 +718,19 @@ fn the_last_stage_evolves_a_block_fit_along_a_valley_of_its_pose() {
     assert_eq!(contacts, 0);
 }
 
+#[test]
+fn a_trade_of_blocks_ranked_fifth_by_the_table_is_refined_and_mends_the_picture() {
+    // The planted boxes 11504 as `bsa new` designed it, and its solve with the last stage
+    // to run again (IoU 0.9629): a long block end-on in a cluster of crossing blocks,
+    // drawing a short block's part, and the short block stretched over a long block's
+    // part. The table of seats ranks that trade fifth (its seats share the cluster);
+    // refining only the best four left the picture at 0.9631.
+    let (iou, contacts, stop) = last_stage_again("block-trade");
+    // 0.9733 when written.
+    assert!(iou > 0.97, "IoU {iou}; {stop}");
+    assert_eq!(contacts, 0);
+}
+
 /// Mickey, each stage cut to a few iterations: a solve that ends far below its target.
 fn short_mickey(name: &str) -> crate::util::TempDir {
     variant(name, |v| {
