@@ -285,6 +285,7 @@ fn tiny_solution(p: &Problem) -> Solution {
     let none = std::sync::atomic::AtomicUsize::new(0);
     let opts = crate::optimize::solver::SolveOptions {
         threads: Some(1),
+        schedule: crate::optimize::solver::Schedule::DEFAULT.with_attempts(1),
         ..Default::default()
     };
     crate::optimize::solver::solve(&q, &opts, &mut crate::optimize::solver::Silent, &none).0

@@ -8,6 +8,7 @@ use anyhow::Result;
 use crate::energy::{Term, Weights};
 use crate::evaluate::Problem;
 use crate::geometry::shape::Shape;
+use crate::optimize::solver::Schedule;
 use crate::scene::Strategy;
 
 use super::{load, CheckArgs};
@@ -168,6 +169,10 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         let f = problem.frame_ious(&problem.start_parameters(), &mut ws);
         super::frames::print(&problem, &f);
     }
+    println!(
+        "  cost     {}",
+        super::progress::cost_line(&problem, &Schedule::DEFAULT, None)
+    );
     println!("ok");
     Ok(())
 }

@@ -126,6 +126,10 @@ struct SolveArgs {
     /// best picture is kept [default: 2].
     #[arg(long)]
     attempts: Option<usize>,
+    /// Stop after this many seconds with the best picture so far, saved as a complete
+    /// result (the stages left are skipped) [default: no limit].
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    time_limit: Option<f64>,
     /// Continue from the output folder's solution.json (skips its completed stages).
     #[arg(long)]
     resume: bool,

@@ -35,7 +35,7 @@ use crate::design::plant::{default_strategy, Stage};
 use crate::design::{self, chess, separate, AutoRequest, DesignError, Order, Request};
 use crate::energy::Weights;
 use crate::evaluate::Problem;
-use crate::optimize::solver::{self, Silent, SolveOptions};
+use crate::optimize::solver::{self, Schedule, Silent, SolveOptions};
 use crate::output::files;
 use crate::scene::{Contacts, Scene, SceneError};
 
@@ -723,8 +723,8 @@ fn design_variant(
 
 /// Solve the design as `bsa solve` will solve the scene written from it: the same file
 /// (so the same start, strategy and seed), loaded afresh, but without the last stage's
-/// trades and polish (`SolveOptions::skip_trades`, `skip_polish`: they compare designs,
-/// not rescues or refinements). One thread: the designs are solved side by side, and a
+/// trades and polish ([`Schedule::TRIAL`]: they compare designs, not rescues or
+/// refinements). One thread: the designs are solved side by side, and a
 /// solve's result does not depend on its thread count.
 fn trial_solve(plan: &Plan, file: &Path, name: &str, seed: u64) -> Result<Solved> {
     let json = plan.scene_json(name, SCRATCH_TARGET, seed);
@@ -732,8 +732,7 @@ fn trial_solve(plan: &Plan, file: &Path, name: &str, seed: u64) -> Result<Solved
     let problem = Problem::new(load::scene(file)?);
     let options = SolveOptions {
         threads: Some(1),
-        skip_trades: true,
-        skip_polish: true,
+        schedule: Schedule::TRIAL,
         ..SolveOptions::default()
     };
     let (solution, _) = solver::solve(&problem, &options, &mut Silent, &INTERRUPTS);

@@ -357,3 +357,35 @@ impl crate::budget::Progress for BudgetProgress {
         }
     }
 }
+
+/// What a solve of `problem` with `schedule` will cost, in one line: its time on the
+/// machine's (or `threads`) threads, its samples and its memory (the scene as loaded,
+/// read from the process, plus what the solve adds).
+pub(super) fn cost_line(
+    problem: &crate::evaluate::Problem,
+    schedule: &crate::optimize::solver::Schedule,
+    threads: Option<usize>,
+) -> String {
+    use crate::optimize::solver::cost;
+    let threads = threads.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    let c = cost::estimate(problem, schedule, threads);
+    format!(
+        "a solve takes about {} to {} on {threads} threads, {} samples at most, about {} of memory",
+        cost::duration(c.seconds.0),
+        cost::duration(c.seconds.1),
+        c.samples,
+        cost::bytes(resident_bytes() + c.bytes)
+    )
+}
+
+/// The memory this process holds now (bytes; 0 where the system does not say).
+fn resident_bytes() -> usize {
+    std::fs::read_to_string("/proc/self/statm")
+        .ok()
+        .and_then(|s| s.split_whitespace().nth(1)?.parse::<usize>().ok())
+        .map_or(0, |pages| pages * 4096)
+}

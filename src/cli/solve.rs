@@ -10,7 +10,7 @@ use anyhow::{bail, Context, Result};
 use crate::budget::Tolerances;
 use crate::energy::Weights;
 use crate::evaluate::{FrameIou, Problem, Robust};
-use crate::optimize::solver::{self, SolveOptions};
+use crate::optimize::solver::{self, Schedule, SolveOptions};
 use crate::output::files;
 use crate::output::solution::{self, Solution};
 use crate::scene::LaunchPositions;
@@ -34,6 +34,8 @@ pub(super) struct Options {
     threads: Option<usize>,
     /// Between 1 and [`MAX_ATTEMPTS`].
     attempts: usize,
+    /// `--time-limit`, positive and finite.
+    time_limit: Option<std::time::Duration>,
     resume: bool,
     /// Replace another scene's results in the output folder.
     force: bool,
@@ -49,6 +51,8 @@ pub(super) struct Options {
 
 /// The most attempts `--attempts` accepts.
 const MAX_ATTEMPTS: usize = 16;
+/// The longest `--time-limit` (s): a week.
+const MAX_TIME_LIMIT: f64 = 7.0 * 24.0 * 3600.0;
 
 /// Perturbed launches per sample of `--robust` unless `--draws` says otherwise.
 const DEFAULT_DRAWS: usize = 16;
@@ -66,10 +70,17 @@ impl Options {
                 bail!("--threads must be between 1 and {MAX_THREADS}, got {n}");
             }
         }
-        let attempts = args.attempts.unwrap_or(solver::DEFAULT_ATTEMPTS);
+        let attempts = args.attempts.unwrap_or(Schedule::DEFAULT.attempts);
         if !(1..=MAX_ATTEMPTS).contains(&attempts) {
             bail!("--attempts must be between 1 and {MAX_ATTEMPTS}, got {attempts}");
         }
+        let time_limit = match args.time_limit {
+            Some(s) if !(s > 0.0 && s <= MAX_TIME_LIMIT) => bail!(
+                "--time-limit must be a number of seconds above 0 and at most {MAX_TIME_LIMIT}, got {}",
+                crate::budget::short(s)
+            ),
+            limit => limit.map(std::time::Duration::from_secs_f64),
+        };
         let tolerances = [
             ("--speed-tol", args.speed_tol),
             ("--direction-tol", args.direction_tol),
@@ -141,6 +152,7 @@ impl Options {
             seed: args.seed,
             threads: args.threads,
             attempts,
+            time_limit,
             resume: args.resume,
             force: args.force,
             report: args.report,
@@ -330,11 +342,17 @@ fn solve_into(
         threads: opts.threads,
         seed,
         resume: resume_from,
-        skip_trades: false,
-        skip_polish: false,
-        attempts: opts.attempts,
+        schedule: Schedule::DEFAULT.with_attempts(opts.attempts),
+        time_limit: opts.time_limit,
     };
     clock.lap("resume and output folder");
+    if !opts.quiet {
+        let cost = super::progress::cost_line(problem, &options.schedule, opts.threads);
+        let limit = opts.time_limit.map_or(String::new(), |l| {
+            format!(" (stopped at {:.1} s)", l.as_secs_f64())
+        });
+        eprintln!("{}: {cost}{limit}", scene.name);
+    }
     let first_stage = options.resume.as_ref().map_or(0, |s| s.stages_completed);
     let (solution, records) = solver::solve(problem, &options, &mut observer, &INTERRUPTS);
     // The solver's time, split: its stages, and the rest (the summary and the per-phase

@@ -377,6 +377,20 @@ impl Problem {
         }
     }
 
+    /// The memory one [`Workspace`] takes (bytes), about: its shadow mask, a pose and a
+    /// flight per body (an asymmetric body's grid of orientations, a few hundred), and
+    /// the pair contacts.
+    pub fn workspace_bytes(&self) -> usize {
+        let n = self.scene.occluders.len();
+        let mask = Mask::new(1, 1);
+        let words = self.canvas.width_px.div_ceil(64) * self.canvas.height_px;
+        std::mem::size_of::<Workspace>()
+            + std::mem::size_of_val(&mask)
+            + 8 * words
+            + n * (std::mem::size_of::<FreeFlight>() + 32 * 300 + 64)
+            + 9 * n * n.saturating_sub(1) / 2
+    }
+
     /// Evaluate one sample. `params` holds 6 values per occluder (`v` then `w`); values of
     /// non-launched occluders are ignored. Terms with weight 0 are skipped.
     pub fn evaluate(&self, params: &[f64], weights: &Weights, ws: &mut Workspace) -> Evaluation {

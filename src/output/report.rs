@@ -216,6 +216,7 @@ pub fn report_html(dir: &Path, s: &Solution) -> Result<String, ExportError> {
         );
     }
     h.push_str("</table>\n");
+    passes_html(&mut h, s);
 
     if let Some(md) = read_optional(&dir.join("budget.md"))? {
         h.push_str("<h2>Error budget</h2>\n");
@@ -235,6 +236,58 @@ pub fn report_html(dir: &Path, s: &Solution) -> Result<String, ExportError> {
     }
     h.push_str("<p><small>Written by bsa (ballistic-shadow-art).</small></p>\n</body></html>\n");
     Ok(h)
+}
+
+/// The passes of the solver's schedule that ran: a line per kind of pass (how often,
+/// its samples, its time and the IoU it gained in all), then every pass in order.
+fn passes_html(h: &mut String, s: &Solution) {
+    if s.passes.is_empty() {
+        return;
+    }
+    h.push_str(
+        "<h2>Passes</h2>\n<table><tr><th>pass</th><th>ran</th><th>samples</th>\
+         <th>wall time (s)</th><th>IoU gained</th></tr>\n",
+    );
+    let mut kinds: Vec<&str> = Vec::new();
+    for p in &s.passes {
+        if !kinds.contains(&p.pass.as_str()) {
+            kinds.push(&p.pass);
+        }
+    }
+    for kind in kinds {
+        let of: Vec<_> = s.passes.iter().filter(|p| p.pass == kind).collect();
+        let _ = writeln!(
+            h,
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.2}</td><td>{:+.4}</td></tr>",
+            esc(kind),
+            of.len(),
+            of.iter().map(|p| p.samples).sum::<usize>(),
+            of.iter().map(|p| p.wall_time_s).sum::<f64>(),
+            of.iter().map(|p| p.iou_after - p.iou_before).sum::<f64>(),
+        );
+    }
+    h.push_str(
+        "</table>\n<details><summary>Every pass</summary>\n<table><tr><th>attempt</th>\
+         <th>stage</th><th>pass</th><th>IoU before</th><th>IoU after</th><th>samples</th>\
+         <th>wall time (s)</th></tr>\n",
+    );
+    for p in &s.passes {
+        let stage = s.stages.get(p.stage).map_or("", |st| st.name.as_str());
+        let _ = writeln!(
+            h,
+            "<tr><td>{}</td><td>{} {}</td><td>{}</td><td>{:.4}</td><td>{:.4}</td><td>{}</td>\
+             <td>{:.3}</td></tr>",
+            p.attempt + 1,
+            p.stage + 1,
+            esc(stage),
+            esc(&p.pass),
+            p.iou_before,
+            p.iou_after,
+            p.samples,
+            p.wall_time_s
+        );
+    }
+    h.push_str("</table></details>\n");
 }
 
 /// Write `dir/report.html` for `solution`; returns its path.
@@ -277,7 +330,12 @@ mod tests {
             "time_per_term_us": {},
             "stages": [{"name": "fine", "iterations": 2, "samples": 10, "population": 5,
                 "best_energy": 902.0, "iou": 0.99, "stop": "iteration cap",
-                "wall_time_s": 0.1}]
+                "wall_time_s": 0.1}],
+            "passes": [
+                {"attempt": 0, "stage": 0, "pass": "moves", "iou_before": 0.5,
+                 "iou_after": 0.6, "samples": 4, "wall_time_s": 0.01},
+                {"attempt": 0, "stage": 0, "pass": "runs", "iou_before": 0.6,
+                 "iou_after": 0.99, "samples": 6, "wall_time_s": 0.09}]
         });
         serde_json::from_value(v).unwrap()
     }
@@ -300,6 +358,9 @@ mod tests {
         );
         assert!(d0 < xor);
         assert!(page.contains("No contact before t"));
+        // Every pass that ran, and a line per kind with the IoU it gained.
+        assert!(page.contains("<td>runs</td><td>1</td><td>6</td><td>0.09</td><td>+0.3900</td>"));
+        assert!(page.contains("<td>1 fine</td><td>moves</td><td>0.5000</td><td>0.6000</td>"));
         assert!(!page.contains("Error budget"));
         std::fs::write(
             dir.join("budget.md"),

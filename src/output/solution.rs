@@ -144,6 +144,26 @@ pub struct Solution {
     /// attempt kept; `samples`, `iterations` and `wall_time_s` count every attempt.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub attempts: Vec<AttemptRecord>,
+    /// Every pass of the solver's schedule that ran, in order, over every attempt: their
+    /// samples add up to `samples`, each a row of `convergence.csv`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub passes: Vec<PassRecord>,
+}
+
+/// One pass of the solver's schedule that ran (see
+/// [`Schedule`](crate::optimize::solver::Schedule)).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PassRecord {
+    /// The attempt it ran in (0: the first).
+    pub attempt: usize,
+    /// The index of its stage.
+    pub stage: usize,
+    /// `moves`, `exchanges`, `runs`, `trades` or `polish`.
+    pub pass: String,
+    pub iou_before: f64,
+    pub iou_after: f64,
+    pub samples: usize,
+    pub wall_time_s: f64,
 }
 
 /// One attempt of a solve (its stages from the start guess, with its own seed).

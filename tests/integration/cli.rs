@@ -16,6 +16,17 @@ fn check_accepts_mickey() {
         out.contains("scene `mickey`") && out.contains("ok"),
         "{out}"
     );
+    // What a solve will cost, before it runs: its time, samples and memory.
+    let cost = out
+        .lines()
+        .find(|l| l.contains("cost"))
+        .expect("a cost line");
+    assert!(
+        cost.contains("a solve takes about")
+            && cost.contains("samples at most")
+            && cost.contains("of memory"),
+        "{cost}"
+    );
 }
 
 /// Cut every stage of a scene's JSON to `iterations` of `population` samples.

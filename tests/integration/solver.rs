@@ -5,7 +5,7 @@
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use bsa::evaluate::Problem;
-use bsa::optimize::solver::{self, Observer, SolveOptions};
+use bsa::optimize::solver::{self, Observer, Schedule, SolveOptions};
 use bsa::output::solution::{SampleRecord, Solution};
 
 use crate::util::{root, variant};
@@ -32,9 +32,8 @@ fn same_seed_gives_bit_identical_solution_with_1_and_2_threads() {
             threads: Some(threads),
             seed: Some(7),
             resume: None,
-            skip_trades: false,
-            skip_polish: false,
-            attempts: 1,
+            schedule: Schedule::DEFAULT.with_attempts(1),
+            time_limit: None,
         };
         solver::solve(&p, &opts, &mut solver::Silent, &none)
     };
@@ -50,9 +49,8 @@ fn same_seed_gives_bit_identical_solution_with_1_and_2_threads() {
         threads: Some(2),
         seed: Some(8),
         resume: None,
-        skip_trades: false,
-        skip_polish: false,
-        attempts: 1,
+        schedule: Schedule::DEFAULT.with_attempts(1),
+        time_limit: None,
     };
     let (_, rc) = solver::solve(&p, &opts, &mut solver::Silent, &none);
     assert_ne!(ra, rc);
@@ -74,9 +72,8 @@ fn resume_continues_to_the_same_result() {
         threads: Some(2),
         seed: Some(3),
         resume: None,
-        skip_trades: false,
-        skip_polish: false,
-        attempts: 1,
+        schedule: Schedule::DEFAULT.with_attempts(1),
+        time_limit: None,
     };
     let none = AtomicUsize::new(0);
     let (full, _) = solver::solve(&p, &opts, &mut solver::Silent, &none);
@@ -119,9 +116,8 @@ fn a_stage_stopped_by_a_second_interrupt_runs_again_on_resume() {
         threads: Some(2),
         seed: Some(5),
         resume: None,
-        skip_trades: false,
-        skip_polish: false,
-        attempts: 1,
+        schedule: Schedule::DEFAULT.with_attempts(1),
+        time_limit: None,
     };
     let (stopped, _) = solver::solve(&p, &opts, &mut StopMidFirstStage(&counter), &counter);
     assert_eq!(stopped.stages_completed, 0);
@@ -653,6 +649,24 @@ fn last_stage_again(name: &str) -> (f64, u64, String) {
     crate::util::solve(&scene, &out, &["--resume", "--attempts", "1"]);
     let s = crate::util::read_json(&out.join("solution.json"));
     let stages = s["stages"].as_array().unwrap();
+    // The record adds up: every sample the last stage counts is a row of convergence.csv
+    // and is drawn by one of its passes (the one-body runs of exchanges, trades and the
+    // polish included).
+    let last = stages.len() - 1;
+    let counted = stages[last]["samples"].as_u64().unwrap();
+    let rows = std::fs::read_to_string(out.join("convergence.csv"))
+        .unwrap()
+        .lines()
+        .count() as u64
+        - 1;
+    let by_passes: u64 = s["passes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|p| p["stage"].as_u64() == Some(last as u64))
+        .map(|p| p["samples"].as_u64().unwrap())
+        .sum();
+    assert_eq!((rows, by_passes), (counted, counted), "{name}");
     (
         s["iou"].as_f64().unwrap(),
         s["n_contacts"].as_u64().unwrap(),
@@ -776,6 +790,37 @@ fn a_second_attempt_runs_below_the_target_and_keeps_the_better_picture() {
         .count()
         - 1;
     assert_eq!(rows as u64, samples);
+}
+
+#[test]
+fn a_time_limit_ends_the_solve_with_a_complete_result() {
+    let d = short_mickey("time-limit");
+    let out = d.join("out");
+    // A limit far below one stage: the first run stops at once, the rest is skipped.
+    let text = crate::util::solve(&d, &out, &["--time-limit", "0.000001"]);
+    let s = crate::util::read_json(&out.join("solution.json"));
+    assert_eq!(s["complete"], true, "{text}");
+    assert_eq!(s["stages_completed"], s["stages_total"]);
+    let stops: Vec<&str> = s["stages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|st| st["stop"].as_str().unwrap())
+        .collect();
+    assert_eq!(stops[0], "time limit", "{stops:?}");
+    assert!(
+        stops[1..].iter().all(|&t| t == "skipped (time limit)"),
+        "{stops:?}"
+    );
+    // A complete result: the pictures, the exports and the report are written.
+    for file in ["shadow.png", "report.html", "launch.csv", "convergence.csv"] {
+        assert!(out.join(file).is_file(), "{file}: {text}");
+    }
+    for bad in ["0", "-1", "nan", "1e9"] {
+        let (ok, _, err) = crate::util::bsa(&["solve", d.to_str().unwrap(), "--time-limit", bad]);
+        assert!(!ok);
+        assert!(err.contains("--time-limit must be"), "{err}");
+    }
 }
 
 #[test]
