@@ -62,13 +62,7 @@ pub(super) fn solution_and_scene(
             folder.map_or(".".into(), |p| p.display().to_string())
         );
     }
-    if !file.is_file() {
-        bail!(
-            "{} has no solution.json: run `bsa solve <scene> --out {}` first",
-            dir.display(),
-            dir.display()
-        );
-    }
+    solution_file_found(dir, file, std::fs::metadata(file).map(|m| m.is_file()))?;
     let solution = files::read_solution(file)?;
     let scene_path = match scene {
         Some(p) => p.to_path_buf(),
@@ -80,9 +74,9 @@ pub(super) fn solution_and_scene(
             .unwrap_or_else(|| PathBuf::from("scenes").join(&solution.scene)),
     };
     let loaded = self::scene(&scene_path);
-    // The recorded scene file was gone and `scenes/<name>` was tried instead: say so,
-    // with both paths and the way out.
     let loaded = match (&loaded, scene, &solution.scene_file) {
+        // The recorded scene file was gone and `scenes/<name>` was tried instead: say
+        // so, with both paths and the way out.
         (Err(_), None, Some(recorded)) if !Path::new(recorded).exists() => loaded.with_context(|| {
             format!(
                 "{} names the scene {recorded}, which does not exist, and {} could not stand in for it: put the scene back there, or pass it with --scene",
@@ -90,10 +84,40 @@ pub(super) fn solution_and_scene(
                 scene_path.display()
             )
         }),
+        // The recorded scene file is there but is no scene: the scene's error alone
+        // would not say why that file was read.
+        (Err(_), None, Some(recorded)) => loaded.with_context(|| {
+            format!(
+                "{} names the scene {recorded}, which cannot be loaded: fix it, or pass the scene with --scene",
+                file.display(),
+            )
+        }),
         _ => loaded,
     };
     let problem = problem_for(loaded?, &solution);
     Ok((problem, solution, scene_path))
+}
+
+/// Whether the solution `file` of the output folder `dir` is there to read, from what the
+/// file system says of it (`Ok(is a file)`, or the error of looking): a missing file is
+/// a folder that was never solved; a file that cannot be looked at (permission denied,
+/// an I/O error) is named as unreadable, with the OS reason.
+fn solution_file_found(dir: &Path, file: &Path, found: std::io::Result<bool>) -> Result<()> {
+    match found {
+        Ok(true) => Ok(()),
+        Ok(false) => bail!(
+            "{} has no solution.json ({} is not a file): run `bsa solve <scene> --out {}` first",
+            dir.display(),
+            file.display(),
+            dir.display()
+        ),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => bail!(
+            "{} has no solution.json: run `bsa solve <scene> --out {}` first",
+            dir.display(),
+            dir.display()
+        ),
+        Err(e) => bail!("cannot read {}: {e}", file.display()),
+    }
 }
 
 /// The `<scene>.glb` of the output folder `dir`, checked to be a glTF file written by
@@ -119,4 +143,40 @@ pub(super) fn glb(dir: &Path, problem: &Problem) -> Result<PathBuf> {
         )
     })?;
     Ok(glb)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::io::{Error, ErrorKind};
+    use std::path::Path;
+
+    use super::solution_file_found;
+
+    #[test]
+    fn an_unreadable_solution_is_named_unreadable_not_missing() {
+        let (dir, file) = (Path::new("out"), Path::new("out/solution.json"));
+        assert!(solution_file_found(dir, file, Ok(true)).is_ok());
+        let missing = solution_file_found(dir, file, Err(Error::from(ErrorKind::NotFound)))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            missing.contains("out has no solution.json: run `bsa solve"),
+            "{missing}"
+        );
+        let denied = Error::from_raw_os_error(libc::EACCES);
+        assert_eq!(denied.kind(), ErrorKind::PermissionDenied);
+        let reason = denied.to_string();
+        let unreadable = solution_file_found(dir, file, Err(denied))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            unreadable,
+            format!("cannot read out/solution.json: {reason}")
+        );
+        assert!(reason.contains("ermission denied"), "{reason}");
+        let folder = solution_file_found(dir, file, Ok(false))
+            .unwrap_err()
+            .to_string();
+        assert!(folder.contains("is not a file"), "{folder}");
+    }
 }

@@ -5,8 +5,11 @@
 //! `export` (animated glTF and launch tables of a saved solution), `validate` (Blender
 //! Cycles shadow against the rasterizer), `video` (an MP4 of the flight) and `budget`
 //! (air drag, the drag-compensated launch table and launch tolerances), and `render`
-//! (the shadow of any launch at any instant up to `t`). `validate`
-//! and `video` run the scripts of `blender/` with a Python that has `bpy`.
+//! (the shadow of any launch at any instant up to `t`), `plant` (a problem with a known
+//! answer), `new` (a scene from a picture and a box of objects), `completions` (a shell's
+//! completion script) and `man` (the manual page). `validate`, `blend`
+//! and `video` run the scripts of `blender/` with a Python that has `bpy`. The
+//! help of them all, as markdown, is [`markdown`] (`docs/cli.md`).
 //!
 //! Each subcommand lives in its own file and runs in two steps, in the way of ripgrep:
 //! its raw clap arguments (the `*Args` structs below) are turned once into a validated
@@ -26,6 +29,7 @@ mod blend;
 mod blender;
 mod budget;
 mod check;
+mod docs;
 mod eval;
 mod export;
 mod frames;
@@ -45,6 +49,8 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
+
+pub use docs::markdown;
 
 #[derive(Parser)]
 #[command(
@@ -95,6 +101,28 @@ enum Command {
     /// laid out, hints, start guess, strategy), DIR/target.png and DIR/start.png (the
     /// start guess over the target), ready for `bsa solve DIR`.
     New(NewArgs),
+    /// Print the completion script of a shell for bsa, e.g. `bsa completions bash >
+    /// ~/.local/share/bash-completion/completions/bsa`, `bsa completions zsh >
+    /// ~/.zfunc/_bsa`, `bsa completions fish > ~/.config/fish/completions/bsa.fish`.
+    Completions(CompletionsArgs),
+    /// Print the manual page of bsa, or of one of its subcommands, as roff, e.g. `bsa man
+    /// | man -l -` or `bsa man solve > bsa-solve.1`.
+    Man(ManArgs),
+}
+
+// Raw arguments of `bsa completions`.
+#[derive(Args)]
+struct CompletionsArgs {
+    /// The shell.
+    #[arg(value_enum)]
+    shell: docs::Shell,
+}
+
+// Raw arguments of `bsa man`.
+#[derive(Args)]
+struct ManArgs {
+    /// A subcommand, for its own page (bsa-SUBCOMMAND.1) [default: the page of bsa].
+    subcommand: Option<String>,
 }
 
 // Raw arguments of `bsa check`.
@@ -405,9 +433,22 @@ struct PlantArgs {
 // The objects and the stage of `bsa new` and `bsa plant`.
 #[derive(Args)]
 struct DesignArgs {
-    /// The objects: comma-separated sphere:R, box:XxYxZ or mesh:FILE.obj[@SCALE], each
-    /// with an optional *N count and /DENSITY (metres, kg/m^3; default 705, maple).
-    #[arg(long)]
+    /// The objects: a comma-separated list (e.g. box:0.14x0.07x0.035*4,chess:king,auto:sphere),
+    /// or a JSON file of them (FILE.json).
+    ///
+    /// Each item of a list, in metres: `sphere:R` (a ball of radius R),
+    /// `box:XxYxZ` (a block), `mesh:FILE.obj[@SCALE]` (a closed mesh, its path relative to
+    /// the current folder), `chess:PIECE` (a piece of the built-in chess set: king, queen,
+    /// rook, bishop, knight or pawn) and `chess` (one side of it, 16 pieces). Each takes an
+    /// optional `*N` count and `/DENSITY` in kg/m^3 (default 705, maple; chess pieces 900,
+    /// boxwood). At most one `auto:` item lets `bsa new` choose how many: `auto:sphere`
+    /// (the radii chosen too), `auto:sphere:R`, `auto:box:XxYxZ`,
+    /// `auto:mesh:FILE.obj[@SCALE]` or `auto:chess` (pieces of one side). Or FILE.json: an
+    /// array of {"kind": "sphere" | "box" | "mesh" | "chess", "radius", "size": [X, Y, Z],
+    /// "obj", "scale", "piece", "count": N | "auto", "density"}, its mesh paths relative
+    /// to its folder. `bsa plant` takes neither `auto:` items nor chess pieces by name
+    /// (give them as meshes: mesh:scenes/thinker/pieces/PIECE.obj).
+    #[arg(long, value_name = "LIST|FILE.json")]
     objects: String,
     /// The picture's width on the floor (m); its height follows the picture's aspect.
     #[arg(
@@ -452,5 +493,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Render(args) => render::run(&render::Options::new(args)?),
         Command::Plant(args) => plant::run(&plant::Options::new(args)?),
         Command::New(args) => new::run(&new::Options::new(args)?),
+        Command::Completions(args) => docs::completions(args.shell),
+        Command::Man(args) => docs::man(args.subcommand.as_deref()),
     }
 }

@@ -6,9 +6,10 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 
 use crate::design::inventory::{self, Inventory, Item};
-use crate::design::plant::{self, Layout, Stage};
+use crate::design::plant::{self, Layout, MeshFile, Stage};
 use crate::energy::Weights;
 use crate::evaluate::Problem;
+use crate::geometry::shape::{load_obj, ObjError};
 use crate::output::{files, picture};
 use crate::scene::Launch;
 use crate::shadow::mask::Mask;
@@ -82,14 +83,23 @@ fn read_inventory(arg: &str) -> Result<Inventory> {
         let text = crate::scene::read_input_text(path)
             .with_context(|| format!("--objects: cannot read {}", path.display()))?;
         let base = path.parent().unwrap_or(std::path::Path::new("."));
-        return inventory::parse_json(&text, base)
+        return inventory::parse_json(&text, base, &crate::scene::path_kind)
             .with_context(|| format!("--objects {}", path.display()));
     }
-    inventory::parse(arg).context("--objects")
+    inventory::parse(arg, &crate::scene::path_kind).context("--objects")
+}
+
+/// A mesh of `--objects`, read for the layout, and the absolute path the planted scene
+/// names it by.
+fn read_mesh(obj: &std::path::Path, scale: f64) -> Result<MeshFile, ObjError> {
+    Ok(MeshFile {
+        mesh: load_obj(obj, scale)?,
+        path: std::fs::canonicalize(obj).unwrap_or_else(|_| obj.to_path_buf()),
+    })
 }
 
 pub(super) fn run(opts: &Options) -> Result<()> {
-    let layout = Layout::new(opts.stage.clone(), &opts.items)?;
+    let layout = Layout::new(opts.stage.clone(), &opts.items, &read_mesh)?;
     let dir = &opts.dir;
     let created = !dir.exists();
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;

@@ -7,13 +7,20 @@
 //! [`parse_json`] reads the same from a JSON file. Errors name the item (or the
 //! JSON entry and field) and say why. A mesh's file must exist when the list is read:
 //! its path is taken as given (relative to the current folder, or to a JSON list's
-//! folder) and nowhere else, so that the error names the path the user wrote.
+//! folder) and nowhere else, so that the error names the path the user wrote. The
+//! caller looks at the file system for the parser (a [`Look`], which the command line
+//! makes of [`crate::scene::path_kind`]): `design` touches no file itself.
 
 use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
 use super::chess;
+use crate::scene::PathKind;
+
+/// How the parser asks what a mesh path names: [`crate::scene::path_kind`], or a stand-in
+/// in tests.
+pub type Look<'a> = &'a dyn Fn(&Path) -> std::io::Result<PathKind>;
 
 /// Density of an object when the list gives none (kg/m^3): hard maple, the wood of
 /// Caroline Pratt's unit blocks. Chess pieces default to boxwood ([`chess::BOXWOOD`]).
@@ -141,15 +148,37 @@ struct Spec {
     density: Option<f64>,
 }
 
+/// Why one number or file of an item is refused (the reason of an
+/// [`InventoryError::Item`] or [`InventoryError::Json`]).
+#[derive(Debug, thiserror::Error)]
+enum Fault {
+    /// A size or scale that is not in (0, 1000].
+    #[error("{what} must be positive and at most 1000, got {got}")]
+    NotPositive { what: String, got: String },
+    /// A mesh path that names a folder.
+    #[error("{} is a folder, not an OBJ file{relative_to}", .path.display())]
+    Folder {
+        path: PathBuf,
+        relative_to: &'static str,
+    },
+    /// A mesh path that cannot be looked at (missing, or not readable).
+    #[error("cannot read the OBJ file {}: {source}{relative_to}", .path.display())]
+    Unreadable {
+        path: PathBuf,
+        source: std::io::Error,
+        relative_to: &'static str,
+    },
+}
+
 /// Check a positive number of at most 1000 (m, or a scale).
-fn positive(x: f64, what: &str) -> Result<f64, String> {
+fn positive(x: f64, what: &str) -> Result<f64, Fault> {
     if x.is_finite() && x > 0.0 && x <= 1e3 {
         Ok(x)
     } else {
-        Err(format!(
-            "{what} must be positive and at most 1000, got {}",
-            crate::scene::short(x)
-        ))
+        Err(Fault::NotPositive {
+            what: what.to_string(),
+            got: crate::scene::short(x),
+        })
     }
 }
 
@@ -159,8 +188,10 @@ fn add(
     inv: &mut Inventory,
     auto_at: &mut Option<usize>,
     index: usize,
+    look: Look,
 ) -> Result<(), (String, String)> {
     let bad = |field: &str, reason: String| (field.to_string(), reason);
+    let fault = |field: &str, reason: Fault| (field.to_string(), reason.to_string());
     let density = match spec.density {
         Some(d) if !(d.is_finite() && d > 0.0 && d <= 1e5) => {
             return Err(bad(
@@ -192,16 +223,16 @@ fn add(
     };
     let need = |v: Option<f64>, field: &str, what: &str| -> Result<f64, (String, String)> {
         let x = v.ok_or_else(|| bad(field, format!("{what} is missing")))?;
-        positive(x, what).map_err(|r| bad(field, r))
+        positive(x, what).map_err(|r| fault(field, r))
     };
     let scale = match spec.scale {
-        Some(s) => positive(s, "scale").map_err(|r| bad("scale", r))?,
+        Some(s) => positive(s, "scale").map_err(|r| fault("scale", r))?,
         None => 1.0,
     };
     let mesh = || -> Result<PathBuf, (String, String)> {
         match &spec.obj {
             Some(p) if !p.as_os_str().is_empty() => {
-                mesh_file(p, spec.obj_base.as_deref()).map_err(|r| bad("obj", r))?;
+                mesh_file(p, spec.obj_base.as_deref(), look).map_err(|r| fault("obj", r))?;
                 Ok(p.clone())
             }
             _ => Err(bad("obj", "mesh needs an OBJ file".into())),
@@ -213,7 +244,7 @@ fn add(
             .ok_or_else(|| bad("size", "box size must be XxYxZ in metres".into()))?;
         let mut out = [0.0; 3];
         for (o, x) in out.iter_mut().zip(s) {
-            *o = positive(x, "box size").map_err(|r| bad("size", r))?;
+            *o = positive(x, "box size").map_err(|r| fault("size", r))?;
         }
         Ok(out)
     };
@@ -245,7 +276,7 @@ fn add(
         let kind = match spec.kind.as_str() {
             "sphere" => AutoKind::Sphere {
                 radius: match spec.radius {
-                    Some(r) => Some(positive(r, "radius").map_err(|e| bad("radius", e))?),
+                    Some(r) => Some(positive(r, "radius").map_err(|e| fault("radius", e))?),
                     None => None,
                 },
             },
@@ -320,7 +351,7 @@ fn add(
 /// `base`, a JSON list's folder): the scene that `bsa new` writes elsewhere must not
 /// find another file of that name relative to its own folder. The reason names the
 /// path and what it is relative to. The file's contents are checked when it is loaded.
-fn mesh_file(path: &Path, base: Option<&Path>) -> Result<(), String> {
+fn mesh_file(path: &Path, base: Option<&Path>, look: Look) -> Result<(), Fault> {
     let relative_to = match base {
         Some(b) if path.is_relative() || path.starts_with(b) => {
             " (a JSON list's mesh paths are relative to the list's folder)"
@@ -329,16 +360,17 @@ fn mesh_file(path: &Path, base: Option<&Path>) -> Result<(), String> {
         None if path.is_relative() => " (mesh paths are relative to the current folder)",
         None => "",
     };
-    match std::fs::metadata(path) {
-        Ok(m) if m.is_dir() => Err(format!(
-            "{} is a folder, not an OBJ file{relative_to}",
-            path.display()
-        )),
-        Ok(_) => Ok(()),
-        Err(e) => Err(format!(
-            "cannot read the OBJ file {}: {e}{relative_to}",
-            path.display()
-        )),
+    match look(path) {
+        Ok(PathKind::Folder) => Err(Fault::Folder {
+            path: path.to_path_buf(),
+            relative_to,
+        }),
+        Ok(PathKind::File) => Ok(()),
+        Err(source) => Err(Fault::Unreadable {
+            path: path.to_path_buf(),
+            source,
+            relative_to,
+        }),
     }
 }
 
@@ -356,8 +388,8 @@ fn bad_count(n: &str) -> String {
     }
 }
 
-/// Parse a comma-separated object list.
-pub fn parse(list: &str) -> Result<Inventory, InventoryError> {
+/// Parse a comma-separated object list; `look` tells what a mesh path names.
+pub fn parse(list: &str, look: Look) -> Result<Inventory, InventoryError> {
     let mut inv = Inventory {
         items: Vec::new(),
         auto: None,
@@ -446,7 +478,7 @@ pub fn parse(list: &str) -> Result<Inventory, InventoryError> {
                 })
             }
         }
-        add(spec, &mut inv, &mut auto_at, index).map_err(|(_, reason)| bad(reason))?;
+        add(spec, &mut inv, &mut auto_at, index, look).map_err(|(_, reason)| bad(reason))?;
     }
     if inv.items.is_empty() && inv.auto.is_none() {
         return Err(InventoryError::Empty);
@@ -457,8 +489,9 @@ pub fn parse(list: &str) -> Result<Inventory, InventoryError> {
 /// Parse a JSON object list: an array (or `{"objects": [...]}`) of entries
 /// `{"kind": "sphere" | "box" | "mesh" | "chess", "radius": R, "size": [X, Y, Z],
 /// "obj": FILE, "scale": S, "piece": NAME, "count": N | "auto", "density": D}` with the
-/// fields of their kind. Mesh paths are relative to `base` (the file's folder).
-pub fn parse_json(text: &str, base: &Path) -> Result<Inventory, InventoryError> {
+/// fields of their kind. Mesh paths are relative to `base` (the file's folder); `look`
+/// tells what one names.
+pub fn parse_json(text: &str, base: &Path, look: Look) -> Result<Inventory, InventoryError> {
     let json = |field: String, reason: String| InventoryError::Json { field, reason };
     let v: Value = serde_json::from_str(text)
         .map_err(|e| json("objects".into(), format!("not valid JSON: {e}")))?;
@@ -582,7 +615,7 @@ pub fn parse_json(text: &str, base: &Path) -> Result<Inventory, InventoryError> 
             count,
             density: num("density")?,
         };
-        add(spec, &mut inv, &mut auto_at, i + 1).map_err(|(f, r)| json(at(&f), r))?;
+        add(spec, &mut inv, &mut auto_at, i + 1, look).map_err(|(f, r)| json(at(&f), r))?;
     }
     if inv.items.is_empty() && inv.auto.is_none() {
         return Err(InventoryError::Empty);
@@ -594,11 +627,16 @@ pub fn parse_json(text: &str, base: &Path) -> Result<Inventory, InventoryError> 
 mod tests {
     use super::*;
 
+    /// The file system as the command line looks at it.
+    const LOOK: Look = &crate::scene::path_kind;
+
     #[test]
     fn counts_densities_and_scales_are_read() {
-        let inv =
-            parse("box:0.14x0.07x0.035*2/600, sphere:0.1, mesh:scenes/thinker/pieces/pawn.obj@2*3")
-                .unwrap();
+        let inv = parse(
+            "box:0.14x0.07x0.035*2/600, sphere:0.1, mesh:scenes/thinker/pieces/pawn.obj@2*3",
+            LOOK,
+        )
+        .unwrap();
         let items = inv.items;
         assert_eq!(items.len(), 6);
         assert_eq!(
@@ -624,7 +662,7 @@ mod tests {
 
     #[test]
     fn chess_and_auto_items_are_read() {
-        let inv = parse("chess").unwrap();
+        let inv = parse("chess", LOOK).unwrap();
         assert_eq!(inv.items.len(), 16);
         assert!(inv.items.iter().all(|i| i.density == chess::BOXWOOD));
         let pawns = inv
@@ -638,7 +676,7 @@ mod tests {
             })
             .count();
         assert_eq!(pawns, 8);
-        let inv = parse("chess:king,auto:box:0.14x0.07x0.035/650").unwrap();
+        let inv = parse("chess:king,auto:box:0.14x0.07x0.035/650", LOOK).unwrap();
         assert_eq!(inv.items.len(), 1);
         assert_eq!(
             inv.auto,
@@ -650,15 +688,15 @@ mod tests {
             })
         );
         assert_eq!(
-            parse("auto:sphere").unwrap().auto.unwrap().kind,
+            parse("auto:sphere", LOOK).unwrap().auto.unwrap().kind,
             AutoKind::Sphere { radius: None }
         );
         assert_eq!(
-            parse("auto:sphere:0.2").unwrap().auto.unwrap().kind,
+            parse("auto:sphere:0.2", LOOK).unwrap().auto.unwrap().kind,
             AutoKind::Sphere { radius: Some(0.2) }
         );
         assert_eq!(
-            parse("auto:chess").unwrap().auto.unwrap().kind,
+            parse("auto:chess", LOOK).unwrap().auto.unwrap().kind,
             AutoKind::Chess
         );
     }
@@ -669,11 +707,11 @@ mod tests {
             {"kind": "box", "size": [0.14, 0.07, 0.035], "count": 2, "density": 600},
             {"kind": "mesh", "obj": "pawn.obj", "scale": 2},
             {"kind": "sphere", "count": "auto"}]}"#;
-        let inv = parse_json(text, Path::new("scenes/thinker/pieces")).unwrap();
+        let inv = parse_json(text, Path::new("scenes/thinker/pieces"), LOOK).unwrap();
         assert_eq!(inv.items.len(), 3);
         assert_eq!(
             inv.items[0],
-            parse("box:0.14x0.07x0.035/600").unwrap().items[0]
+            parse("box:0.14x0.07x0.035/600", LOOK).unwrap().items[0]
         );
         assert_eq!(
             inv.items[2].kind,
@@ -713,7 +751,7 @@ mod tests {
             ),
             ("mesh:scenes", "scenes is a folder"),
         ] {
-            let e = parse(list).unwrap_err().to_string();
+            let e = parse(list, LOOK).unwrap_err().to_string();
             assert!(e.contains(expect), "{list}: {e}");
         }
         for (text, expect) in [
@@ -754,7 +792,9 @@ mod tests {
             ),
             ("[1", "not valid JSON"),
         ] {
-            let e = parse_json(text, Path::new(".")).unwrap_err().to_string();
+            let e = parse_json(text, Path::new("."), LOOK)
+                .unwrap_err()
+                .to_string();
             assert!(e.contains(expect), "{text}: {e}");
         }
     }

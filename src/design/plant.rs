@@ -18,7 +18,7 @@ use serde_json::{json, Value};
 use super::inventory::{Item, Kind};
 use crate::energy::Weights;
 use crate::evaluate::Problem;
-use crate::geometry::shape::{load_obj, ObjError};
+use crate::geometry::shape::{ObjError, TriMesh};
 use crate::scene::Launch;
 use crate::shadow::mask::Mask;
 
@@ -75,6 +75,19 @@ pub enum PlantError {
     },
 }
 
+/// A mesh of the inventory as the caller read it (the command line, with the OBJ
+/// reader): `design` touches no file itself.
+pub struct MeshFile {
+    /// The mesh, scaled.
+    pub mesh: TriMesh,
+    /// The path the scene names it by: absolute, so that the scene written elsewhere
+    /// finds it.
+    pub path: std::path::PathBuf,
+}
+
+/// How [`Layout::new`] reads a mesh: (OBJ path as the list gives it, scale) to the mesh.
+pub type ReadMesh<'a> = &'a dyn Fn(&std::path::Path, f64) -> Result<MeshFile, ObjError>;
+
 /// The objects of an inventory placed on the floor, ready to be written as a scene.
 #[derive(Clone, Debug)]
 pub struct Layout {
@@ -85,8 +98,8 @@ pub struct Layout {
 
 impl Layout {
     /// Place `items` in rows on the floor, in front of the picture (negative y), each
-    /// resting on it.
-    pub fn new(stage: Stage, items: &[Item]) -> Result<Layout, PlantError> {
+    /// resting on it; `read_mesh` reads the meshes' files.
+    pub fn new(stage: Stage, items: &[Item], read_mesh: ReadMesh) -> Result<Layout, PlantError> {
         let h = stage.picture_height();
         let mut objects = Vec::new();
         let (mut x, mut y, mut row_depth) = (0.0f64, -(0.5 * h + 0.5), 0.0f64);
@@ -114,17 +127,17 @@ impl Layout {
                     })
                 }
                 Kind::Mesh { obj, scale } => {
-                    let mesh = load_obj(obj, *scale).map_err(|source| PlantError::Mesh {
-                        path: obj.display().to_string(),
-                        source,
-                    })?;
+                    let MeshFile { mesh, path: abs } =
+                        read_mesh(obj, *scale).map_err(|source| PlantError::Mesh {
+                            path: obj.display().to_string(),
+                            source,
+                        })?;
                     let (mut lo, mut hi) =
                         (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
                     for v in &mesh.vertices {
                         lo = lo.min(*v);
                         hi = hi.max(*v);
                     }
-                    let abs = std::fs::canonicalize(obj).unwrap_or_else(|_| obj.clone());
                     (
                         json!({"mesh": {"obj": abs.display().to_string(), "scale": scale}}),
                         (hi - lo).truncate(),

@@ -499,6 +499,27 @@ pub fn read_input_text(path: &Path) -> std::io::Result<String> {
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
 }
 
+/// What a path names, for a check made before the file is read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PathKind {
+    /// A file (or anything else that is not a folder).
+    File,
+    /// A folder.
+    Folder,
+}
+
+/// What `path` names, or why it cannot be looked at (the OS reason): the look the object
+/// lists of `bsa new` and `bsa plant` take at their mesh files, passed to
+/// [`crate::design::inventory::parse`] by the command line, so that `design` itself
+/// touches no file.
+pub fn path_kind(path: &Path) -> std::io::Result<PathKind> {
+    Ok(if std::fs::metadata(path)?.is_dir() {
+        PathKind::Folder
+    } else {
+        PathKind::File
+    })
+}
+
 /// Load and validate a scene. `path` is the scene JSON file or a folder holding `scene.json`.
 pub fn load(path: &Path) -> Result<Scene> {
     let file = if path.is_dir() {

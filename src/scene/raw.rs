@@ -113,24 +113,36 @@ pub(super) enum RawHints {
     Inline(Vec<RawHint>),
 }
 
-impl TryFrom<serde_json::Value> for RawHints {
-    type Error = String;
+/// Why a `hints` value is not hints (serde puts the message into the scene's JSON error,
+/// which names the field).
+#[derive(Debug, thiserror::Error)]
+pub(super) enum HintsError {
+    /// A hint of the list is malformed: its index, then the path and serde's message.
+    #[error("hint [{index}], {message}")]
+    Hint { index: usize, message: String },
+    /// Neither a file name nor a list.
+    #[error("must be a file name or a list of hints ({{\"occluder\", \"point\": [x, y, z], \"pixel\": [x, y], \"weight\"}}), got {got}")]
+    Kind { got: serde_json::Value },
+}
 
-    fn try_from(value: serde_json::Value) -> Result<Self, String> {
+impl TryFrom<serde_json::Value> for RawHints {
+    type Error = HintsError;
+
+    fn try_from(value: serde_json::Value) -> Result<Self, HintsError> {
         match value {
             serde_json::Value::String(file) => Ok(RawHints::File(file)),
             serde_json::Value::Array(items) => items
                 .into_iter()
                 .enumerate()
-                .map(|(k, item)| {
-                    serde_path_to_error::deserialize(item)
-                        .map_err(|e| format!("hint [{k}], {}", at_path(e)))
+                .map(|(index, item)| {
+                    serde_path_to_error::deserialize(item).map_err(|e| HintsError::Hint {
+                        index,
+                        message: at_path(e),
+                    })
                 })
                 .collect::<Result<_, _>>()
                 .map(RawHints::Inline),
-            other => Err(format!(
-                "must be a file name or a list of hints ({{\"occluder\", \"point\": [x, y, z], \"pixel\": [x, y], \"weight\"}}), got {other}"
-            )),
+            got => Err(HintsError::Kind { got }),
         }
     }
 }

@@ -6,7 +6,7 @@
 use std::path::Path;
 use std::process::Command;
 
-use crate::util::{bsa, quick_solve, root, solve, tmpdir, variant};
+use crate::util::{bsa, quick_solve, read_json, root, shared_quick_solve, solve, tmpdir, variant};
 
 #[test]
 fn check_accepts_mickey() {
@@ -907,4 +907,68 @@ fn a_solution_whose_scene_file_is_gone_names_the_recorded_path() {
         !ok && err.contains("nowhere/scene.json") && err.contains("--scene"),
         "{err}"
     );
+}
+
+/// A solution whose recorded scene file is not a scene: the error names the solution
+/// and the scene file, for `export` and `budget` alike (it named the scene file alone).
+#[test]
+fn a_recorded_scene_that_is_no_scene_is_named_with_its_solution() {
+    let solved = shared_quick_solve("mickey");
+    let d = tmpdir("bad-recorded-scene");
+    let scene = d.join("scene.json");
+    std::fs::write(&scene, "not a scene").unwrap();
+    let out = d.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let mut solution = read_json(&solved.join("solution.json"));
+    solution["scene_file"] = scene.display().to_string().into();
+    std::fs::write(
+        out.join("solution.json"),
+        serde_json::to_string_pretty(&solution).unwrap(),
+    )
+    .unwrap();
+    let file = out.join("solution.json");
+    for args in [vec!["export"], vec!["budget", "-q"]] {
+        let mut args = args;
+        args.insert(1, out.to_str().unwrap());
+        let (ok, _, err) = bsa(&args);
+        let first = err.lines().next().unwrap_or("");
+        assert!(
+            !ok && first.contains(&file.display().to_string())
+                && first.contains(&scene.display().to_string())
+                && err.contains("expected")
+                && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
+    }
+}
+
+/// A solution.json that cannot be read is reported as unreadable, with the OS reason,
+/// not as missing. Run as root, which reads the file whatever its mode, the test says
+/// so and checks nothing (the unit test
+/// `an_unreadable_solution_is_named_unreadable_not_missing` checks the wording on a
+/// permission error of the OS).
+#[test]
+fn an_unreadable_solution_is_not_called_missing() {
+    use std::os::unix::fs::PermissionsExt;
+    let d = tmpdir("unreadable-solution");
+    let file = d.join("solution.json");
+    // Never read, so any content will do.
+    std::fs::write(&file, "{}").unwrap();
+    std::fs::set_permissions(&file, std::fs::Permissions::from_mode(0o000)).unwrap();
+    if std::fs::read(&file).is_ok() {
+        // Root: the commands would read the solution and run in full.
+        eprintln!("note: {} is readable after chmod 000 (running as root): the permission error is not checked here", file.display());
+        return;
+    }
+    for cmd in ["export", "budget"] {
+        let (ok, _, err) = bsa(&[cmd, d.to_str().unwrap(), "--scene", "scenes/mickey"]);
+        assert!(!err.contains("no solution.json"), "{cmd}: {err}");
+        assert!(
+            !ok && err.contains("cannot read")
+                && err.contains(&file.display().to_string())
+                && err.contains("ermission denied"),
+            "{cmd}: {err}"
+        );
+    }
+    std::fs::set_permissions(&file, std::fs::Permissions::from_mode(0o644)).unwrap();
 }

@@ -1,6 +1,8 @@
 //! The integration tests, one binary (as in ripgrep's `tests/`), a module per boundary:
 //!
 //! - `cli`: the `bsa` command line end to end and its errors for bad solutions and exports;
+//! - `docs`: `docs/cli.md` generated from the clap definitions, the shell completions,
+//!   the man page;
 //! - `scene_errors`: bad scenes get clear errors that name the file and the field;
 //! - `solver`: determinism, resume, interrupts, strategies, the golden shadow, Mickey;
 //! - `exports`: the glTF poses and tables, the Khronos validator, the error budget;
@@ -23,6 +25,7 @@
 mod blend;
 mod blender;
 mod cli;
+mod docs;
 mod exports;
 mod fuzz;
 mod instants;

@@ -24,7 +24,7 @@ pub struct Figure {
 trait Draw {
     /// Size of the figure in pixels.
     fn size(&self) -> (u32, u32);
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>;
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError>;
 }
 
 fn render(plot: &impl Draw, what: &'static str) -> Result<Figure, PictureError> {
@@ -33,14 +33,14 @@ fn render(plot: &impl Draw, what: &'static str) -> Result<Figure, PictureError> 
     let mut buf = vec![255u8; w as usize * h as usize * 3];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-        plot.draw(&root).map_err(|x| draw_err(what, x))?;
+        plot.draw(&root).map_err(|x| draw_err(what, x.0))?;
         root.present().map_err(|x| draw_err(what, x))?;
     }
     let png = RgbImage::from_raw(w, h, buf).expect("buffer has the figure's size");
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
-        plot.draw(&root).map_err(|x| draw_err(what, x))?;
+        plot.draw(&root).map_err(|x| draw_err(what, x.0))?;
         root.present().map_err(|x| draw_err(what, x))?;
     }
     Ok(Figure { png, svg })
@@ -68,8 +68,14 @@ fn font(size: u32) -> TextStyle<'static> {
     TextStyle::from(("sans-serif", size).into_font()).color(&BLACK_TEXT)
 }
 
-fn e<E: std::fmt::Debug>(e: E) -> String {
-    format!("{e:?}")
+/// A plotters error in its debug form (plotters' errors are generic over the backend);
+/// [`render`] names the figure.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+struct DrawError(String);
+
+fn e<E: std::fmt::Debug>(e: E) -> DrawError {
+    DrawError(format!("{e:?}"))
 }
 
 /// How one series is drawn: colour, width and whether dashed.
@@ -88,7 +94,7 @@ fn draw_line<DB: DrawingBackend>(
     >,
     points: Vec<(f64, f64)>,
     pen: Pen,
-) -> Result<(), String> {
+) -> Result<(), DrawError> {
     let style = pen.color.stroke_width(pen.width);
     if pen.dashed {
         chart
@@ -107,7 +113,7 @@ fn draw_legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     top: i32,
     entries: &[(Pen, String)],
-) -> Result<(), String> {
+) -> Result<(), DrawError> {
     let text = font(14);
     for (i, (pen, name)) in entries.iter().enumerate() {
         let y = top + 22 * i as i32;
@@ -286,7 +292,7 @@ impl Draw for ConvergencePlot<'_> {
         (1200, 560)
     }
 
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
         let data = self.data;
         root.fill(&WHITE).map_err(e)?;
         let (w, _) = self.size();
@@ -461,7 +467,7 @@ impl Draw for HistogramData {
         (900, 480)
     }
 
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
         root.fill(&WHITE).map_err(e)?;
         let (w, _) = self.size();
         let (plot_area, legend_area) = root.split_horizontally(w - 230);
@@ -556,7 +562,7 @@ impl Draw for GridData {
         (cols * PANEL.0, GRID_HEADER + rows * PANEL.1)
     }
 
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
         root.fill(&WHITE).map_err(e)?;
         let (header, body) = root.split_vertically(GRID_HEADER);
         header
