@@ -7,10 +7,13 @@
 //! file as written, loaded afresh.
 //!
 //! The design is made under each of [`design::CEILINGS`] in each of [`design::ORDERS`];
-//! by default ([`ChooseBy::Solve`]) each design that differs from those before it is
-//! then solved as `bsa solve` will solve it (the scene's seed, the scene's strategy)
-//! and the one whose solve ends at the best picture, contact-free first, is written. A start guess's IoU says little of where its solve ends: on 27 held-out
-//! pictures the design with the best start was the best solved one for 12. When no
+//! by default ([`ChooseBy::Solve`]) the designs that differ from those before them
+//! then race: each is solved as `bsa solve` will solve it (the scene's seed, the
+//! scene's strategy, [`Schedule::TRIAL`]) to a quarter of its stages, the better half
+//! goes on to half of them, the better half of those to the end ([`race`]), and the
+//! one whose solve ends at the best picture, contact-free first, is written. A start
+//! guess's IoU says little of where its solve ends: on 27 held-out pictures the design
+//! with the best start was the best solved one for 12. When no
 //! trial reaches [`design::REPLACE_BELOW`], a second [`Round`] designs every setting
 //! again with its objects placed anew ([`design::cover::Cover::replace`]) and solves
 //! those, and the best of both rounds is written.
@@ -37,6 +40,7 @@ use crate::energy::Weights;
 use crate::evaluate::Problem;
 use crate::optimize::solver::{self, Schedule, Silent, SolveOptions};
 use crate::output::files;
+use crate::output::solution::Solution;
 use crate::scene::{Contacts, Scene, SceneError};
 
 use super::guard::NothingWritten;
@@ -351,7 +355,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let best_trial = designed
         .iter()
         .filter_map(|v| v.as_ref().ok()?.solved)
-        .filter(|s| s.clear)
+        .filter(|s| s.clear && s.finished())
         .map(|s| s.iou)
         .fold(f64::NEG_INFINITY, f64::max);
     if trial && best_trial < design::REPLACE_BELOW && INTERRUPTS.load(Ordering::SeqCst) == 0 {
@@ -500,6 +504,15 @@ struct Solved {
     iou: f64,
     /// No contact before `t`.
     clear: bool,
+    /// The stages it ran, of all: fewer for a design the race left behind.
+    stages: (usize, usize),
+}
+
+impl Solved {
+    /// Whether its solve ran every stage (it won its way to the race's last rung).
+    fn finished(&self) -> bool {
+        self.stages.0 >= self.stages.1
+    }
 }
 
 /// One design of the picture under one ceiling and order, made contact-free.
@@ -524,11 +537,12 @@ impl Variant {
 }
 
 /// The order of [`Variant::better_than`] as a tuple: a design with a trial solve
-/// ranks by it, and by its start guess after that.
-fn rank(solved: Option<Solved>, clear: bool, iou: f64) -> (bool, f64, bool, f64) {
+/// ranks by it (one that ran every stage before one the race left behind), and by its
+/// start guess after that.
+fn rank(solved: Option<Solved>, clear: bool, iou: f64) -> (bool, bool, f64, bool, f64) {
     match solved {
-        Some(s) => (s.clear, s.iou, clear, iou),
-        None => (clear, iou, clear, iou),
+        Some(s) => (s.finished(), s.clear, s.iou, clear, iou),
+        None => (true, clear, iou, clear, iou),
     }
 }
 
@@ -561,8 +575,19 @@ fn trials_line(seen: &[Trial], kept: Setting) -> String {
                     let ious: Vec<String> = trials
                         .iter()
                         .map(|s| match s {
-                            Trial::Solved(Some(s)) if s.clear => format!("{:.4}", s.iou),
-                            Trial::Solved(Some(s)) => format!("{:.4} (contact)", s.iou),
+                            Trial::Solved(Some(s)) => format!(
+                                "{:.4}{}{}",
+                                s.iou,
+                                if s.clear { "" } else { " (contact)" },
+                                if s.finished() {
+                                    String::new()
+                                } else {
+                                    format!(
+                                        " (raced out after {} of {} stages)",
+                                        s.stages.0, s.stages.1
+                                    )
+                                }
+                            ),
                             Trial::Solved(None) | Trial::Failed => "-".to_string(),
                             Trial::Same => "same".to_string(),
                         })
@@ -670,23 +695,24 @@ impl Round<'_> {
         let todo: Vec<usize> = ks
             .filter(|&k| designed[k].is_ok() && same_as[k].is_none())
             .collect();
-        let bar = progress::steps(todo.len() as u64, &format!("{name}: solving the designs"));
-        let solved: Vec<(usize, Result<Solved>)> = todo
+        let loaded: Vec<(usize, Result<Problem>)> = todo
             .par_iter()
             .map(|&k| {
                 let v = designed[k].as_ref().expect("a design to solve");
-                // One begun stops at once: its solver watches the same counter.
-                let s = unless_interrupted(|| trial_solve(&v.plan, &self.files[k], name, seed));
-                bar.inc(1);
-                (k, s)
+                let p = unless_interrupted(|| trial_problem(&v.plan, &self.files[k], name, seed));
+                (k, p)
             })
             .collect();
-        bar.finish_and_clear();
-        for (k, s) in solved {
-            match s {
-                Ok(s) => designed[k].as_mut().expect("a solved design").solved = Some(s),
+        let mut entrants = Vec::new();
+        for (k, p) in loaded {
+            match p {
+                Ok(p) => entrants.push((k, p)),
                 Err(e) => designed[k] = Err(e),
             }
+        }
+        // A solve begun stops at once on Ctrl-C: its solver watches the same counter.
+        for (k, s) in race(entrants, name) {
+            designed[k].as_mut().expect("a raced design").solved = Some(s);
         }
     }
 }
@@ -721,25 +747,96 @@ fn design_variant(
     })
 }
 
-/// Solve the design as `bsa solve` will solve the scene written from it: the same file
-/// (so the same start, strategy and seed), loaded afresh, but without the last stage's
-/// trades and polish ([`Schedule::TRIAL`]: they compare designs, not rescues or
-/// refinements). One thread: the designs are solved side by side, and a
-/// solve's result does not depend on its thread count.
-fn trial_solve(plan: &Plan, file: &Path, name: &str, seed: u64) -> Result<Solved> {
+/// The design as `bsa solve` will solve the scene written from it: the same file (so
+/// the same start, strategy and seed), loaded afresh.
+fn trial_problem(plan: &Plan, file: &Path, name: &str, seed: u64) -> Result<Problem> {
     let json = plan.scene_json(name, SCRATCH_TARGET, seed);
     files::write_atomic(file, serde_json::to_string_pretty(&json)?.as_bytes())?;
-    let problem = Problem::new(load::scene(file)?);
-    let options = SolveOptions {
-        threads: Some(1),
-        schedule: Schedule::TRIAL,
-        ..SolveOptions::default()
-    };
-    let (solution, _) = solver::solve(&problem, &options, &mut Silent, &INTERRUPTS);
-    Ok(Solved {
-        iou: solution.iou,
-        clear: solution.n_contacts == 0,
-    })
+    Ok(Problem::new(load::scene(file)?))
+}
+
+/// The share of its stages each rung of the race solves a design to: every design
+/// runs the first quarter, the better half of them the next quarter, the better half
+/// of those the rest (successive halving: half the samples of solving each to its end).
+const RUNGS: [f64; 3] = [0.25, 0.5, 1.0];
+
+/// Race the designs `entrants` (each with its index): each rung of [`RUNGS`] solves
+/// every design left to its share of the stages, resuming where the last rung left it,
+/// and keeps the better half (contact-free first, then the higher IoU) for the next.
+/// The solves leave out the last stage's trades and polish ([`Schedule::TRIAL`]: they
+/// compare designs, not rescues or refinements) and run on one thread each, the
+/// designs side by side (a solve's result does not depend on its thread count).
+/// Returns where each design's solve ended.
+fn race(mut entrants: Vec<(usize, Problem)>, name: &str) -> Vec<(usize, Solved)> {
+    let mut ended = Vec::new();
+    let mut reached: Vec<Option<Solution>> = entrants.iter().map(|_| None).collect();
+    for (r, share) in RUNGS.into_iter().enumerate() {
+        let bar = progress::steps(
+            entrants.len() as u64,
+            &format!(
+                "{name}: racing {} designs ({} of the stages)",
+                entrants.len(),
+                share
+            ),
+        );
+        let solved: Vec<Solution> = entrants
+            .par_iter()
+            .zip(reached.par_iter_mut())
+            .map(|((_, problem), from)| {
+                let stages = problem.scene.stages.len();
+                let options = SolveOptions {
+                    threads: Some(1),
+                    schedule: Schedule::TRIAL,
+                    resume: from.take(),
+                    until_stage: Some(((share * stages as f64).ceil() as usize).clamp(1, stages)),
+                    ..SolveOptions::default()
+                };
+                let (s, _) = solver::solve(problem, &options, &mut Silent, &INTERRUPTS);
+                bar.inc(1);
+                s
+            })
+            .collect();
+        bar.finish_and_clear();
+        let mut order: Vec<usize> = (0..entrants.len()).collect();
+        let key = |s: &Solution| (s.n_contacts == 0, s.iou);
+        order.sort_by(|&a, &b| {
+            key(&solved[b])
+                .partial_cmp(&key(&solved[a]))
+                .expect("IoUs are numbers")
+        });
+        let keep = if r + 1 == RUNGS.len() {
+            order.len()
+        } else {
+            order.len().div_ceil(2)
+        };
+        let mut next = Vec::new();
+        let mut next_reached = Vec::new();
+        let mut slots: Vec<Option<(usize, Problem)>> = entrants.into_iter().map(Some).collect();
+        for (place, &j) in order.iter().enumerate() {
+            let (k, problem) = slots[j].take().expect("each design once");
+            let s = &solved[j];
+            let finished = s.stages_completed >= s.stages_total;
+            if place < keep && !finished {
+                next.push((k, problem));
+                next_reached.push(Some(s.clone()));
+            } else {
+                ended.push((
+                    k,
+                    Solved {
+                        iou: s.iou,
+                        clear: s.n_contacts == 0,
+                        stages: (s.stages_completed, s.stages_total),
+                    },
+                ));
+            }
+        }
+        entrants = next;
+        reached = next_reached;
+        if entrants.is_empty() || INTERRUPTS.load(Ordering::SeqCst) > 0 {
+            break;
+        }
+    }
+    ended
 }
 
 /// An error of the first scene, which is a scratch file the user never wrote, told in

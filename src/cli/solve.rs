@@ -344,6 +344,7 @@ fn solve_into(
         resume: resume_from,
         schedule: Schedule::DEFAULT.with_attempts(opts.attempts),
         time_limit: opts.time_limit,
+        until_stage: None,
     };
     clock.lap("resume and output folder");
     if !opts.quiet {

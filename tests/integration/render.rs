@@ -216,10 +216,7 @@ fn new_designs_a_scene_that_solve_takes_as_it_is() {
     // A trial reaches 0.985 (`design::REPLACE_BELOW`), so the designs are not made
     // again with their objects placed anew.
     let (_, orders, (_, kept)) = trials(&out);
-    let best = orders
-        .iter()
-        .flat_map(|o| o.1.iter().flatten().copied())
-        .fold(0.0, f64::max);
+    let best = finished(&orders).fold(0.0, f64::max);
     assert!(best >= 0.985, "{out}");
     assert_eq!(orders.len(), 2, "{out}");
     assert!(!kept.contains("placed anew"), "{out}");
@@ -437,9 +434,21 @@ fn new_fly(dir: &Path, extra: &[&str]) -> String {
 }
 
 /// What `bsa new` printed of its trial solves: the ceilings, each order's trial IoUs
-/// (`None` for a design that an earlier one made too, "same"; the second round's
-/// orders, when it ran, labelled "..., placed anew") and the ceiling and order it kept.
-type Trials = (Vec<f64>, Vec<(String, Vec<Option<f64>>)>, (f64, String));
+/// (`None` for a design that an earlier one made too, "same"; `Some(None)` for one the
+/// race of the designs left behind before its last stage; the second round's orders,
+/// when it ran, labelled "..., placed anew") and the ceiling and order it kept.
+type Trials = (
+    Vec<f64>,
+    Vec<(String, Vec<Option<Option<f64>>>)>,
+    (f64, String),
+);
+
+/// The IoUs of the designs that ran every stage of their trial.
+fn finished(orders: &[(String, Vec<Option<Option<f64>>>)]) -> impl Iterator<Item = f64> + '_ {
+    orders
+        .iter()
+        .flat_map(|o| o.1.iter().flatten().flatten().copied())
+}
 
 /// The trial solves' line of `bsa new`'s output, parsed ([`Trials`]).
 fn trials(out: &str) -> Trials {
@@ -447,6 +456,18 @@ fn trials(out: &str) -> Trials {
         .lines()
         .find(|l| l.contains("trial solves under ceilings "))
         .unwrap_or_else(|| panic!("{out}"));
+    // A design the race left behind: its IoU where it stopped, marked.
+    let mut marked = String::new();
+    for (k, part) in line.split(" (raced out after ").enumerate() {
+        match k {
+            0 => marked.push_str(part),
+            _ => {
+                marked.push('~');
+                marked.push_str(part.split_once("stages)").map_or(part, |p| p.1));
+            }
+        }
+    }
+    let line = marked.as_str();
     let between = |after: &str, before: &str| -> String {
         let s = line.split(after).nth(1).unwrap_or_else(|| panic!("{line}"));
         s.split(before).next().unwrap().to_string()
@@ -464,7 +485,7 @@ fn trials(out: &str) -> Trials {
             let (ious, label) = order.split_once(" (").unwrap_or_else(|| panic!("{line}"));
             let ious = ious
                 .split(" / ")
-                .map(|v| (v != "same").then(|| v.parse().unwrap()))
+                .map(|v| (v != "same").then(|| (!v.ends_with('~')).then(|| v.parse().unwrap())))
                 .collect();
             let label = label.trim_end_matches(')');
             let label = match round {
@@ -503,16 +524,15 @@ fn new_keeps_the_design_that_solves_best_and_solve_ends_where_its_trial_did() {
         ],
         "{out}"
     );
-    // Every design is solved once: the first order's all, the second's where it differs.
+    // Every design races once: the first order's all, the second's where it differs;
+    // the race leaves some behind before their last stage.
     assert!(orders[0].1.iter().all(Option::is_some), "{out}");
     assert!(orders.iter().all(|o| o.1.len() == 4), "{out}");
-    let best = orders
-        .iter()
-        .flat_map(|o| o.1.iter().flatten().copied())
-        .fold(0.0, f64::max);
+    assert!(orders.iter().any(|o| o.1.contains(&Some(None))), "{out}");
+    let best = finished(&orders).fold(0.0, f64::max);
     let at = ceilings.iter().position(|&c| c == ceiling).unwrap();
     let kept = orders.iter().find(|o| o.0 == order).unwrap().1[at];
-    assert_eq!(kept, Some(best), "{out}");
+    assert_eq!(kept, Some(Some(best)), "{out}");
     // The written scene is the design that was tried: its solve's last stage ends where
     // the trial did, and its polish (which the trials leave out, with the trades; fly's
     // solve takes none) goes on from there to a picture no worse.

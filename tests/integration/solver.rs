@@ -34,6 +34,7 @@ fn same_seed_gives_bit_identical_solution_with_1_and_2_threads() {
             resume: None,
             schedule: Schedule::DEFAULT.with_attempts(1),
             time_limit: None,
+            until_stage: None,
         };
         solver::solve(&p, &opts, &mut solver::Silent, &none)
     };
@@ -51,6 +52,7 @@ fn same_seed_gives_bit_identical_solution_with_1_and_2_threads() {
         resume: None,
         schedule: Schedule::DEFAULT.with_attempts(1),
         time_limit: None,
+        until_stage: None,
     };
     let (_, rc) = solver::solve(&p, &opts, &mut solver::Silent, &none);
     assert_ne!(ra, rc);
@@ -74,6 +76,7 @@ fn resume_continues_to_the_same_result() {
         resume: None,
         schedule: Schedule::DEFAULT.with_attempts(1),
         time_limit: None,
+        until_stage: None,
     };
     let none = AtomicUsize::new(0);
     let (full, _) = solver::solve(&p, &opts, &mut solver::Silent, &none);
@@ -118,6 +121,7 @@ fn a_stage_stopped_by_a_second_interrupt_runs_again_on_resume() {
         resume: None,
         schedule: Schedule::DEFAULT.with_attempts(1),
         time_limit: None,
+        until_stage: None,
     };
     let (stopped, _) = solver::solve(&p, &opts, &mut StopMidFirstStage(&counter), &counter);
     assert_eq!(stopped.stages_completed, 0);

@@ -62,6 +62,10 @@ pub struct SolveOptions {
     /// as a complete result: the run under way ends, and the passes and stages left
     /// are skipped (each skipped stage reported as such).
     pub time_limit: Option<std::time::Duration>,
+    /// Run the stages before this index only (the solution then has that many stages
+    /// completed, and a later solve may resume it): the budget of a design's trial in
+    /// `bsa new`'s race. `None`: every stage.
+    pub until_stage: Option<usize>,
 }
 
 /// Progress of one iteration, for progress bars and previews.
@@ -292,7 +296,14 @@ fn attempt(
     // The scene's last stage of one body: the settings of the one-body runs that refine
     // exchanges, trades and the last stage's polish.
     let one_body = scene.stages.iter().rev().find(|s| s.vary.len() == 1);
-    for (k, stage) in scene.stages.iter().enumerate().skip(first_stage) {
+    let until = options.until_stage.unwrap_or(usize::MAX);
+    for (k, stage) in scene
+        .stages
+        .iter()
+        .enumerate()
+        .skip(first_stage)
+        .take_while(|(k, _)| *k < until)
+    {
         if interrupts.load(Ordering::SeqCst) >= 2 {
             aborted = true;
             break;
