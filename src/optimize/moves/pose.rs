@@ -556,7 +556,7 @@ impl Seats<'_> {
     /// bare ones connected to them.
     fn part(&self, o: usize, bare: &Mask, ws: &mut Workspace) -> Mask {
         self.alone(o, ws);
-        super::part_of(&self.problem.target.mask, &ws.mask, bare)
+        super::sight::part_of(&self.problem.target.mask, &ws.mask, bare)
     }
 
     /// Draw body `i`'s shadow alone, at its pose now, into `ws.mask`.

@@ -1,0 +1,158 @@
+//! Seat: place and pose a body from scratch. [`Seat`] scans every pose of a mesh (and
+//! of a block where the caller asks) on its own place, of two meshes of one kind each
+//! on the other's, of a hidden block and another on the two halves of that one's part,
+//! and, in a call that trades, of two or three bodies each on the next one's place;
+//! the best are refined ([`Seats`]) and launched there. [`PoseFit`] fits every block
+//! to the picture on its pose at `t` (turns, shifts and depth) and launches it there.
+
+use glam::{DQuat, DVec3};
+
+use super::pose::{self, fit_and_launch, Seats, SEAT_KEPT, SEAT_PAIRS};
+use super::sight::exchangeable;
+use super::spin::{launch_to, spin_guesses};
+use super::{Move, Offers, Round, TRADE_SLACK};
+use crate::geometry::shape::Shape;
+use crate::scene::Launch;
+
+/// The seats of a round: in the first round of a call only (in every round of a call
+/// that trades: a trade of two often leaves a third body to seat; and of a call that
+/// seats the blocks: in a cluster of blocks, one seated anew lets the next find its own
+/// pose), since a scan of every pose costs a few thousand shadows of one body, and a
+/// seat that the first round did not take is rarely taken after a smaller move.
+pub(super) struct Seat;
+
+impl Move for Seat {
+    fn offer(&self, r: &Round, out: &mut Offers) {
+        if !(r.first || r.options.trades || r.options.seat_blocks) {
+            return;
+        }
+        let problem = r.problem;
+        let seats = Seats {
+            problem,
+            held: r.held,
+            vary: r.vary,
+            now: &r.current_poses,
+            sights: &r.sights,
+        };
+        // Each on its own place (the blocks too where the caller asks) ...
+        let own: Vec<usize> = if r.options.seat_blocks {
+            r.meshes.iter().chain(r.blocks).copied().collect()
+        } else {
+            r.meshes.to_vec()
+        };
+        for &i in &own {
+            if let Some((cost, pose)) = seats.own(i, out.ws) {
+                if cost < r.wrong {
+                    seat(r, &[(i, pose)], out);
+                }
+            }
+        }
+        // ... and two of a kind each on the other's: every pair scanned, the best
+        // refined.
+        let mut scanned: Vec<(i64, usize, usize)> = Vec::new();
+        for (a, &i) in r.meshes.iter().enumerate() {
+            for &j in &r.meshes[a + 1..] {
+                if !r.exchanges_wanted || !exchangeable(&problem.scene, i, j) {
+                    continue;
+                }
+                if let Some((cost, _)) = seats.pair(i, j, 0, out.ws) {
+                    scanned.push((cost, i, j));
+                }
+            }
+        }
+        scanned.sort();
+        for &(_, i, j) in scanned.iter().take(SEAT_PAIRS) {
+            if let Some((cost, [pi, pj])) = seats.pair(i, j, SEAT_KEPT, out.ws) {
+                if cost < r.wrong {
+                    seat(r, &[(i, pi), (j, pj)], out);
+                }
+            }
+        }
+        // ... and a hidden block seated beside another on that one's part, cut in two:
+        // every cut scanned, the best refined.
+        for (h, j, [place_h, place_j]) in seats.split_scan(r.blocks, &r.bare, out.ws) {
+            let two = seats.two((h, place_h), (j, place_j), SEAT_KEPT, out.ws);
+            if let Some((cost, [ph, pj])) = two {
+                if cost < r.wrong {
+                    seat(r, &[(h, ph), (j, pj)], out);
+                }
+            }
+        }
+        // ... and, when the caller asks, bodies of one kind and different shapes each on
+        // the next one's place: the cycles the table of seats ranks best, refined.
+        let shape = |i: usize| &problem.scene.occluders[i].shape;
+        for group in r.trades {
+            let of_meshes = matches!(shape(group[0]), Shape::Mesh(_));
+            let (cap, slack) = if of_meshes {
+                (pose::MESH_TRADES, TRADE_SLACK)
+            } else {
+                (pose::TRADES, 1)
+            };
+            let first = out.list.len();
+            for cycle in seats.trade_scan(group, cap, out.ws) {
+                if let Some((cost, poses)) = seats.many(&cycle, SEAT_KEPT, out.ws) {
+                    if cost < slack * r.wrong {
+                        let seated: Vec<(usize, (DVec3, DQuat))> =
+                            cycle.iter().map(|c| c.0).zip(poses).collect();
+                        seat(r, &seated, out);
+                    }
+                }
+            }
+            if of_meshes {
+                out.mesh_trades = first..out.list.len();
+            }
+        }
+        out.ws.poses.copy_from_slice(&r.current_poses);
+    }
+}
+
+/// Offer the launch kept with each of `seated`'s bodies launched to its pose at `t`
+/// (the spin by Newton's method from the guesses of [`spin_guesses`]); nothing when a
+/// spin is not found.
+fn seat(r: &Round, seated: &[(usize, (DVec3, DQuat))], out: &mut Offers) {
+    let problem = r.problem;
+    out.candidate.copy_from_slice(r.params);
+    for &(b, pose) in seated {
+        let guesses = spin_guesses(
+            problem,
+            b,
+            Launch::get(r.params, b).angular_velocity,
+            r.turned[b],
+            pose.1,
+        );
+        if !launch_to(problem, b, pose, &guesses, out.candidate, out.flight) {
+            return;
+        }
+    }
+    let bodies: Vec<usize> = seated.iter().map(|s| s.0).collect();
+    out.offer(&bodies);
+}
+
+/// Every block fitted to the picture on its pose at `t`, one after the other
+/// ([`fit_and_launch`]), and launched there: one offer of the blocks that gained.
+pub(super) struct PoseFit;
+
+impl Move for PoseFit {
+    fn offer(&self, r: &Round, out: &mut Offers) {
+        out.candidate.copy_from_slice(r.params);
+        out.ws.poses.copy_from_slice(&r.current_poses);
+        let mut fitted = Vec::new();
+        for &i in r.blocks {
+            if fit_and_launch(
+                r.problem,
+                r.held,
+                r.vary,
+                i,
+                out.candidate,
+                r.options.evolve_fits,
+                out.ws,
+                out.flight,
+            ) {
+                fitted.push(i);
+            }
+        }
+        if !fitted.is_empty() {
+            out.offer(&fitted);
+        }
+    }
+}
