@@ -14,8 +14,11 @@
 # Scenes and solves go to /tmp/bsa-new-suite[-2][-auto]/<picture>/ and <picture>-out/
 # (with <picture>-new.log, what `bsa new` printed);
 # the contact sheet to docs/images/new-suite[-2][-auto].png.
+# Every picture is also a row of results/new-suite.csv (scripts/ledger.sh: set_or_seed
+# "set-NN/seed-S", item the picture, route stated or auto, seconds new + solve).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/ledger.sh
 seed=${1:-1}
 mode=${2:-given}
 cargo build --release --locked --quiet --bin bsa --example contact_sheet
@@ -60,6 +63,12 @@ print("\t".join([name, objects, count, start, f"{s['iou']:.4f}", str(s["n_contac
                  f"{float(t1) - float(t0):.1f}"]))
 PY
     tail -n 1 "$rows"
+    IFS=$'\t' read -r _ _ _ _ final contacts wall < <(tail -n 1 "$rows")
+    samples=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["samples"])' "$dir-out/solution.json")
+    route=stated
+    if [ "$mode" = auto ]; then route=auto; fi
+    ledger_row new-suite "set-$(printf %02d "$set_")/seed-$seed" "$name" "$route" "$final" \
+        "$contacts" "$samples" "$wall"
     overlays+=("$dir-out/overlay.png")
 done < <(python3 - "$pics/manifest.json" <<'PY'
 import json, sys

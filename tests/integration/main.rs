@@ -3,6 +3,7 @@
 //! - `cli`: the `bsa` command line end to end and its errors for bad solutions and exports;
 //! - `docs`: `docs/cli.md` generated from the clap definitions, the shell completions,
 //!   the man page;
+//! - `ledger`: the tables of `docs/results.md` made from the results ledger `results/`;
 //! - `scene_errors`: bad scenes get clear errors that name the file and the field;
 //! - `solver`: determinism, resume, interrupts, strategies, the golden shadow, Mickey;
 //! - `exports`: the glTF poses and tables, the Khronos validator, the error budget;
@@ -29,6 +30,7 @@ mod docs;
 mod exports;
 mod fuzz;
 mod instants;
+mod ledger;
 mod render;
 mod report;
 mod robust;
