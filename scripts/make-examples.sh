@@ -13,7 +13,8 @@
 #   thinker  one side of the chess set (16 pieces), a 0.96 m picture, the light 3 m up
 # Mickey keeps the paper's geometry (scenes/mickey, written by hand).
 # Every design is also a row of results/make-examples.csv (scripts/ledger.sh: item the
-# scene, route new, iou the start guess's, seconds those of `bsa new`).
+# scene, route new, iou the start guess's, contacts 0 when it has none before t,
+# seconds those of `bsa new` with its trial solves).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/ledger.sh
@@ -33,8 +34,10 @@ design() { # name target objects [options...]
     printed=$("$bsa" new "$work/$name" --target "$target" --objects "$objects" "$@")
     t1=$(date +%s.%N)
     printf '%s\n' "$printed"
+    local contacts=""
+    if grep -q "no contact before t" <<<"$printed"; then contacts=0; fi
     ledger_row make-examples - "$name" new \
-        "$(sed -n 's/.*start guess IoU \([0-9.]*\).*/\1/p' <<<"$printed" | tail -1)" "" "" \
+        "$(sed -n 's/.*start guess IoU \([0-9.]*\).*/\1/p' <<<"$printed" | tail -1)" "$contacts" "" \
         "$(python3 -c "print(f'{$t1 - $t0:.2f}')")"
     cp "$work/$name/scene.json" "$work/$name/start.png" "scenes/$name/"
 }

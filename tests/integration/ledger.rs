@@ -32,6 +32,11 @@ const TABLES: [&str; 5] = [
     "new-suite-latest",
 ];
 
+/// The planted draws the page shows, the last in the ledger.
+const LAST_DRAWS: usize = 4;
+/// The runs of the `bsa new` suite the page shows, the last in the ledger.
+const LAST_RUNS: usize = 8;
+
 /// One row of a ledger file.
 #[derive(Clone, Debug)]
 struct Row {
@@ -240,7 +245,35 @@ fn table_speed() -> String {
     t
 }
 
-/// The planted draws: per class the median and lowest IoU and the median wall time.
+/// The examples' designs by `bsa new`: each scene's last row.
+fn table_make_examples() -> String {
+    let rows = ledger("make-examples");
+    let mut t = String::from(
+        "| scene | start guess IoU | contact before t | `bsa new` wall time, trial solves included | commit, date |\n|---|---|---|---|---|\n",
+    );
+    for item in items(&rows) {
+        let Some(r) = rows.iter().rev().find(|r| r.item == item) else {
+            continue;
+        };
+        let contact = match r.contacts {
+            Some(0) => "none".to_string(),
+            Some(n) => n.to_string(),
+            None => "-".to_string(),
+        };
+        let _ = writeln!(
+            t,
+            "| {} | {} | {contact} | {} | {}, {} |",
+            scene_name(&item),
+            iou(r.iou),
+            secs(r.seconds),
+            r.commit,
+            r.date
+        );
+    }
+    t
+}
+
+/// The last planted draws: per class the median and lowest IoU and the median wall time.
 /// A draw's rows are one per problem (item `<class> <seed>`) or, where only the summary
 /// was kept, `<class> median` and `<class> lowest`.
 fn table_planted() -> String {
@@ -252,6 +285,8 @@ fn table_planted() -> String {
             draws.push(key);
         }
     }
+    // The last draws only, so that the page stays short as the ledger grows.
+    let draws = draws.split_off(draws.len().saturating_sub(LAST_DRAWS));
     let mut t = String::from(
         "| draw (first seed) | route | class | problems | median IoU | lowest IoU | contact before t | median wall time | commit |\n|---|---|---|---|---|---|---|---|---|\n",
     );
@@ -315,7 +350,7 @@ fn table_planted() -> String {
     t
 }
 
-/// Every run of the `bsa new` suite: a set and seed, stated objects or `auto:`.
+/// The last runs of the `bsa new` suite: a set and seed, stated objects or `auto:`.
 fn table_new_suite() -> String {
     let rows = ledger("new-suite");
     let mut runs: Vec<(String, String, String)> = Vec::new();
@@ -325,6 +360,7 @@ fn table_new_suite() -> String {
             runs.push(key);
         }
     }
+    let runs = runs.split_off(runs.len().saturating_sub(LAST_RUNS));
     let mut t = String::from(
         "| set / seed | objects | pictures | median IoU | lowest IoU | at 0.90 or more | with a contact before t | commit |\n|---|---|---|---|---|---|---|---|\n",
     );
@@ -396,6 +432,7 @@ fn table(name: &str) -> String {
     match name {
         "examples" => table_examples(),
         "speed" => table_speed(),
+        "make-examples" => table_make_examples(),
         "planted" => table_planted(),
         "new-suite" => table_new_suite(),
         "new-suite-latest" => table_new_suite_latest(),

@@ -180,3 +180,16 @@ fn the_sentence_splitter_counts_cells_and_skips_code() {
     assert_eq!(sentences("A short one. Another? Yes! Done").len(), 4);
     assert!(says_now("It is now faster") && !says_now("a known nowhere"));
 }
+
+/// The front page and the results stay short: README.md at most 200 lines,
+/// docs/results.md at most 500.
+#[test]
+fn readme_and_results_stay_short() {
+    for (page, most) in [("README.md", 200), ("docs/results.md", 500)] {
+        let n = std::fs::read_to_string(root().join(page))
+            .unwrap()
+            .lines()
+            .count();
+        assert!(n <= most, "{page} has {n} lines, more than {most}");
+    }
+}
