@@ -9,9 +9,11 @@
 # seed on all cores (results in /tmp/bsa-bench/<scene>-<seed>/, not in export/) and prints one line
 # per solve: IoU at t, contacts, samples, iterations and the solver's own wall time.
 # Targets (issue "four examples"): mickey <= 5 s, fly <= 10 s, tbc <= 27 s,
-# thinker <= 4 min on 2 cores.
+# thinker <= 4 min on 2 cores. Every solve is also a row of results/bench.csv
+# (scripts/ledger.sh: set_or_seed the seed, item the scene, route solve).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/ledger.sh
 seeds=("$@")
 [ ${#seeds[@]} -eq 0 ] && seeds=(1 2 3)
 cargo build --release --locked --quiet
@@ -25,5 +27,11 @@ for dir in scenes/*/ benches/hand-made/*/; do
         ./target/release/bsa solve "$dir" --seed "$seed" --out "$out" -q --report >"$out.log" 2>&1 ||
             { echo "$name seed $seed: solve failed, see $out.log"; exit 1; }
         echo "seed $seed  $label$(grep -E "^$name: IoU" "$out.log" | sed "s/^$name//")"
+        python3 - "$out/solution.json" <<'PY' | { read -r iou contacts samples wall
+import json, sys
+s = json.load(open(sys.argv[1]))
+print(f"{s['iou']:.4f} {s['n_contacts']} {s['samples']} {s['wall_time_s']:.2f}")
+PY
+            ledger_row bench "$seed" "$label" solve "$iou" "$contacts" "$samples" "$wall"; }
     done
 done

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# The held-out pictures of `bsa new`: for every picture of tools/test-pictures/manifest.tsv
-# (made by `cargo run --release --example test_pictures`, each with its box of objects
-# stated there before any solve), `bsa new` then `bsa solve`, no edits in between, and a
+# The held-out pictures of `bsa new`: for every picture of
+# tools/test-pictures/set-NN/manifest.json (drawn by `cargo run --release --example
+# test_pictures`, each with its objects stated there before any solve), `bsa new` then `bsa solve`, no edits in between, and a
 # table: picture, objects, start IoU, final IoU, contacts before t, wall time (new + solve,
 # whole processes). The overlays are tiled into docs/images/new-suite[-auto].png.
 #
 #     bash scripts/new-suite.sh [SEED] [auto]      # defaults: seed 1, the stated boxes
-#     SET=2 bash scripts/new-suite.sh 1             # set 2 (tools/test-pictures-2), or 3 to 21
+#     SET=2 bash scripts/new-suite.sh 1             # set 2 (tools/test-pictures/set-02), or 3 to 21
 #
 # With `auto`, every picture gets one automatic item of its kind instead (auto:box of the
 # unit block for the block pictures, auto:sphere for the sphere one, auto:chess for the
@@ -14,8 +14,11 @@
 # Scenes and solves go to /tmp/bsa-new-suite[-2][-auto]/<picture>/ and <picture>-out/
 # (with <picture>-new.log, what `bsa new` printed);
 # the contact sheet to docs/images/new-suite[-2][-auto].png.
+# Every picture is also a row of results/new-suite.csv (scripts/ledger.sh: set_or_seed
+# "set-NN/seed-S", item the picture, route stated or auto, seconds new + solve).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/ledger.sh
 seed=${1:-1}
 mode=${2:-given}
 cargo build --release --locked --quiet --bin bsa --example contact_sheet
@@ -23,9 +26,9 @@ bsa=$(cargo metadata --format-version 1 --no-deps | python3 -c 'import json,sys;
 sheet=$bsa/examples/contact_sheet
 bsa=$bsa/bsa
 set_=${SET:-1}
-pics=tools/test-pictures
+pics=tools/test-pictures/set-$(printf %02d "$set_")
 suffix=""
-if [ "$set_" != 1 ]; then pics=tools/test-pictures-$set_; suffix=-$set_; fi
+if [ "$set_" != 1 ]; then suffix=-$set_; fi
 if [ "$mode" = auto ]; then suffix=$suffix-auto; fi
 root=/tmp/bsa-new-suite$suffix
 mkdir -p "$root"
@@ -60,8 +63,19 @@ print("\t".join([name, objects, count, start, f"{s['iou']:.4f}", str(s["n_contac
                  f"{float(t1) - float(t0):.1f}"]))
 PY
     tail -n 1 "$rows"
+    IFS=$'\t' read -r _ _ _ _ final contacts wall < <(tail -n 1 "$rows")
+    samples=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["samples"])' "$dir-out/solution.json")
+    route=stated
+    if [ "$mode" = auto ]; then route=auto; fi
+    ledger_row new-suite "set-$(printf %02d "$set_")/seed-$seed" "$name" "$route" "$final" \
+        "$contacts" "$samples" "$wall"
     overlays+=("$dir-out/overlay.png")
-done <"$pics/manifest.tsv"
+done < <(python3 - "$pics/manifest.json" <<'PY'
+import json, sys
+for p in json.load(open(sys.argv[1]))["pictures"]:
+    print("\t".join([p["name"], p["objects"], p.get("options", "")]))
+PY
+)
 python3 - "$rows" <<'PY'
 import statistics, sys
 rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]

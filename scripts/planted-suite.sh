@@ -18,9 +18,12 @@
 # CLASSES="chess mix" runs only those classes;
 # BSA=PATH runs another binary (e.g. an older build, for a side-by-side comparison); prints one line per problem
 # and a table per class: IoU (min / median / max), solves with a contact before t,
-# samples and wall time (median).
+# samples and wall time (median). Every solve is also a row of results/planted.csv
+# (scripts/ledger.sh: set_or_seed the draw's first seed, item "<class> <seed>", route
+# plant or new; LEDGER_COMMIT=<commit> with BSA=..., LEDGER=0 for none).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/ledger.sh
 first=${1:-1000}
 per=${2:-6}
 if [ -z "${BSA:-}" ]; then cargo build --release --locked --quiet; fi
@@ -86,6 +89,9 @@ wall = s["wall_time_s"] if sys.argv[4] != "new" else float(sys.argv[6]) - float(
 print("\t".join(map(str, [sys.argv[2], sys.argv[3], s["iou"], s["n_contacts"], s["samples"],
                           wall, len(s["occluders"])])))
 PY
+        IFS=$'\t' read -r _ _ iou contacts samples wall _ < <(tail -1 "$results")
+        ledger_row planted "$first" "$class $seed" "${ROUTE:-plant}" "$(printf %.4f "$iou")" \
+            "$contacts" "$samples" "$(printf %.2f "$wall")"
         tail -1 "$results" | awk -F'\t' '{printf "%s seed %s: %d objects, IoU %.4f, %d contacts, %d samples, %.2f s\n", $1, $2, $7, $3, $4, $5, $6}'
     done
 done

@@ -3,6 +3,9 @@
 //! - `cli`: the `bsa` command line end to end and its errors for bad solutions and exports;
 //! - `docs`: `docs/cli.md` generated from the clap definitions, the shell completions,
 //!   the man page;
+//! - `ledger`: the tables of `docs/results.md` made from the results ledger `results/`;
+//! - `prose`: README.md and docs/*.md name no round or session, and no sentence runs
+//!   past 60 words;
 //! - `scene_errors`: bad scenes get clear errors that name the file and the field;
 //! - `solver`: determinism, resume, interrupts, strategies, the golden shadow, Mickey;
 //! - `exports`: the glTF poses and tables, the Khronos validator, the error budget;
@@ -29,6 +32,8 @@ mod docs;
 mod exports;
 mod fuzz;
 mod instants;
+mod ledger;
+mod prose;
 mod render;
 mod report;
 mod robust;
