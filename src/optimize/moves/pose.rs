@@ -731,7 +731,7 @@ pub(super) const SPLITS: usize = 4;
 /// part) is the fifth, and on boxes12 11505 it lies beyond the twelfth. Refining the best
 /// 30 raised those two from 0.9631 and 0.9698 to 0.9733 and 0.9833 (and boxes12 11405
 /// from 0.9629 to 0.9693) and changed none of the other 39 problems with blocks of the
-/// draws 11400 and 11500 (`docs/results.md`, "More trades of blocks refined"); 80 found
+/// draws 11400 and 11500 (`git show c030f18:docs/results.md`, "More trades of blocks refined"); 80 found
 /// nothing more.
 pub(super) const TRADES: usize = 30;
 

@@ -140,7 +140,7 @@ pub(super) fn trade_trials(
 /// without the hints: a hint pulls its body toward the pixel the design chose, 0.3 of a
 /// wrong pixel per pixel of distance, which holds an outline a fraction of a pixel off
 /// its part (on the planted chess 11201, the hints were 434 pixels from their bodies in
-/// all at the end, against 132 wrong pixels). Measured in `docs/results.md`, "A polish
+/// all at the end, against 132 wrong pixels). Measured in `git show c030f18:docs/results.md`, "A polish
 /// of one body at a time".
 #[allow(clippy::too_many_arguments)]
 pub(super) fn polish(

@@ -89,7 +89,7 @@ pub(super) fn rank_value(e: &Evaluation, contacts: Contacts) -> f64 {
 /// the stage's own or the IoU rose by at least `gain` (the stage's `restart_gain`). A run
 /// that left the picture as it was has settled, and a wider run from the same best rarely
 /// finds more: on the examples, the final joint stage's restarts after such a run never
-/// did, and cost half of the solve's time (`docs/results.md`, "Restarts within a
+/// did, and cost half of the solve's time (`git show c030f18:docs/results.md`, "Restarts within a
 /// budget").
 pub(super) fn run_moved_picture(
     gain: f64,
