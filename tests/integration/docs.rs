@@ -29,25 +29,12 @@ const SUBCOMMANDS: [&str; 13] = [
 fn docs_cli_md_is_the_help_of_every_command() {
     let path = root().join("docs/cli.md");
     let made = bsa::cli::markdown();
-    if std::env::var_os("BSA_REGENERATE").is_some_and(|v| v == "1") {
-        std::fs::write(&path, &made).unwrap();
-        eprintln!("wrote {}", path.display());
-        return;
-    }
-    let committed = std::fs::read_to_string(&path).unwrap_or_default();
-    if committed != made {
-        let line = committed
-            .lines()
-            .zip(made.lines())
-            .position(|(a, b)| a != b)
-            .unwrap_or(committed.lines().count().min(made.lines().count()));
-        panic!(
-            "docs/cli.md differs from the help from line {}: regenerate it with `BSA_REGENERATE=1 cargo test --test integration docs::`\ncommitted: {:?}\ngenerated: {:?}",
-            line + 1,
-            committed.lines().nth(line),
-            made.lines().nth(line)
-        );
-    }
+    crate::util::generated(
+        &path,
+        &made,
+        "docs/cli.md differs from the help",
+        "cargo test --test integration docs::",
+    );
     // Every subcommand has its section, and each section is what `--help` prints.
     for sub in SUBCOMMANDS {
         assert!(made.contains(&format!("\n## bsa {sub}\n")), "{sub}");

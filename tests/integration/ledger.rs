@@ -475,24 +475,12 @@ fn docs_results_md_tables_are_the_ledger() {
     let path = root().join("docs/results.md");
     let committed = std::fs::read_to_string(&path).unwrap();
     let made = regenerated(&committed);
-    if std::env::var_os("BSA_REGENERATE").is_some_and(|v| v == "1") {
-        std::fs::write(&path, &made).unwrap();
-        eprintln!("wrote {}", path.display());
-        return;
-    }
-    if committed != made {
-        let line = committed
-            .lines()
-            .zip(made.lines())
-            .position(|(a, b)| a != b)
-            .unwrap_or(committed.lines().count().min(made.lines().count()));
-        panic!(
-            "docs/results.md's tables differ from the ledger (results/*.csv) from line {}: regenerate them with `BSA_REGENERATE=1 cargo test --test integration ledger::`\ncommitted: {:?}\ngenerated: {:?}",
-            line + 1,
-            committed.lines().nth(line),
-            made.lines().nth(line)
-        );
-    }
+    crate::util::generated(
+        &path,
+        &made,
+        "docs/results.md's tables differ from the ledger (results/*.csv)",
+        "cargo test --test integration ledger::",
+    );
 }
 
 #[test]

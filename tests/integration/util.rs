@@ -357,3 +357,28 @@ fn temporary_folders_are_removed_after_a_pass_and_kept_after_a_failure() {
     assert!(failed.is_err() && kept.join("file").is_file());
     std::fs::remove_dir_all(kept).unwrap();
 }
+
+/// A generated file kept in the repository: with `BSA_REGENERATE=1`, write `made` to
+/// `path`; otherwise fail where the committed file differs, naming `what` and `how` to
+/// regenerate it.
+pub fn generated(path: &Path, made: &str, what: &str, how: &str) {
+    if std::env::var_os("BSA_REGENERATE").is_some_and(|v| v == "1") {
+        std::fs::write(path, made).unwrap();
+        eprintln!("wrote {}", path.display());
+        return;
+    }
+    let committed = std::fs::read_to_string(path).unwrap_or_default();
+    if committed != made {
+        let line = committed
+            .lines()
+            .zip(made.lines())
+            .position(|(a, b)| a != b)
+            .unwrap_or(committed.lines().count().min(made.lines().count()));
+        panic!(
+            "{what} from line {}: regenerate with `BSA_REGENERATE=1 {how}`\ncommitted: {:?}\ngenerated: {:?}",
+            line + 1,
+            committed.lines().nth(line),
+            made.lines().nth(line)
+        );
+    }
+}

@@ -100,7 +100,24 @@ struct Offers<'s, 'a> {
     mesh_trades: Range<usize>,
 }
 
-impl Offers<'_, '_> {
+impl<'s, 'a> Offers<'s, 'a> {
+    fn new(
+        search: &'s mut Search<'a>,
+        ws: &'s mut Workspace,
+        candidate: &'s mut Vec<f64>,
+        flight: &'s mut FreeFlight,
+    ) -> Self {
+        Offers {
+            search,
+            ws,
+            candidate,
+            flight,
+            list: Vec::new(),
+            exchanges: Vec::new(),
+            mesh_trades: 0..0,
+        }
+    }
+
     /// Evaluate the candidate as a move of `bodies` and keep it.
     fn offer(&mut self, bodies: &[usize]) {
         let eval = self.search.evaluate(self.candidate, self.ws);
@@ -357,15 +374,7 @@ pub fn improve(
         let mut best_rank = rank(&current);
         let mut found = None;
         // Every move of the round, evaluated; the best few are then polished.
-        let mut out = Offers {
-            search: &mut search,
-            ws: &mut *ws,
-            candidate: &mut candidate,
-            flight: &mut flight,
-            list: Vec::new(),
-            exchanges: Vec::new(),
-            mesh_trades: 0..0,
-        };
+        let mut out = Offers::new(&mut search, ws, &mut candidate, &mut flight);
         for m in MOVES {
             m.offer(&round, &mut out);
         }
@@ -387,15 +396,7 @@ pub fn improve(
         // Polish the moves that made the best pictures (a move that made a poor one
         // seldom becomes the best by a change of depth), then take the best-ranked.
         offers.sort_by(|a, b| search.free(&a.eval).total_cmp(&search.free(&b.eval)));
-        let mut scratch = Offers {
-            search: &mut search,
-            ws: &mut *ws,
-            candidate: &mut candidate,
-            flight: &mut flight,
-            list: Vec::new(),
-            exchanges: Vec::new(),
-            mesh_trades: 0..0,
-        };
+        let mut scratch = Offers::new(&mut search, ws, &mut candidate, &mut flight);
         polish_best(&mut offers, held, &vary, options, &mut scratch);
         for offer in &offers {
             let r = rank(&offer.eval);
