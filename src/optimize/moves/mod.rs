@@ -437,7 +437,7 @@ pub fn improve(
 /// Slide the [`POLISHED`] best of `offers` (sorted best first; those of one body only
 /// where `options.polish_single`) in depth ([`Search::polish`]), and fit the blocks of
 /// the best one and of every polished swap on their new poses
-/// ([`fit_and_launch`](pose::fit_and_launch)), keeping a fit that draws a better
+/// ([`fit_and_launch`]), keeping a fit that draws a better
 /// picture. A block turned onto another face, or sent to a new part, rarely has its
 /// part's size, place and tilt at once. (Fitting those of all four best moves raised
 /// the hand-made "to fly" a little more at 1.1 to 1.35 times the time: the spins that
