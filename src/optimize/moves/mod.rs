@@ -24,6 +24,7 @@ mod pose;
 mod reassign;
 mod reorient;
 mod seat;
+mod seats;
 mod sight;
 mod slide;
 mod spin;
@@ -247,7 +248,7 @@ pub struct MoveOptions {
     /// stroke 0.004 of IoU worse).
     pub polish_single: bool,
     /// Trade places among bodies of one kind and different shapes, and seat the meshes,
-    /// in every pass ([`Seats::trade_scan`](pose::Seats::trade_scan)); a call that asks
+    /// in every pass ([`Seats::trade_scan`](seats::Seats::trade_scan)); a call that asks
     /// for trades where no group may trade (no two blocks of different sizes, and no two
     /// meshes of different shapes among at most [`MAX_MESH_TRADES`] ordered pairs)
     /// moves nothing.
@@ -287,22 +288,12 @@ pub fn improve(
     record: &mut dyn FnMut(&Evaluation),
 ) -> MoveReport {
     let scene = &problem.scene;
-    let movable: Vec<usize> = vary
-        .iter()
-        .copied()
-        .filter(|&i| scene.occluders[i].launched)
-        .collect();
     let mut report = MoveReport::default();
-    let blocks: Vec<usize> = movable
-        .iter()
-        .copied()
-        .filter(|&i| fits_pose(&scene.occluders[i].shape))
-        .collect();
-    let meshes: Vec<usize> = movable
-        .iter()
-        .copied()
-        .filter(|&i| matches!(scene.occluders[i].shape, Shape::Mesh(_)))
-        .collect();
+    let Bodies {
+        movable,
+        blocks,
+        meshes,
+    } = Bodies::of(scene, vary);
     // The groups that trade places: the blocks, and the meshes where few enough.
     let shape = |i: usize| &scene.occluders[i].shape;
     let trades: Vec<&[usize]> = [&blocks[..], &meshes[..]]
@@ -330,17 +321,7 @@ pub fn improve(
     let mut flight = FreeFlight::default();
     let mut exchanges: Vec<Exchange> = Vec::new();
     let mut trade_offers: Vec<Trade> = Vec::new();
-    let pairs = movable
-        .iter()
-        .enumerate()
-        .map(|(a, &i)| {
-            movable[a + 1..]
-                .iter()
-                .filter(|&&j| exchangeable(scene, i, j))
-                .count()
-        })
-        .sum::<usize>();
-    let exchanges_wanted = pairs <= MAX_EXCHANGE_PAIRS;
+    let exchanges_wanted = exchange_pairs(scene, &movable) <= MAX_EXCHANGE_PAIRS;
     let vary: Vec<bool> = (0..scene.occluders.len())
         .map(|k| movable.contains(&k))
         .collect();
@@ -432,6 +413,51 @@ pub fn improve(
         .filter(|(energy, _)| *energy < kept)
         .map(|(_, launch)| launch);
     report
+}
+
+/// The launched bodies of `vary`, and the blocks and meshes among them.
+struct Bodies {
+    movable: Vec<usize>,
+    blocks: Vec<usize>,
+    meshes: Vec<usize>,
+}
+
+impl Bodies {
+    fn of(scene: &crate::scene::Scene, vary: &[usize]) -> Bodies {
+        let movable: Vec<usize> = vary
+            .iter()
+            .copied()
+            .filter(|&i| scene.occluders[i].launched)
+            .collect();
+        let of = |keep: &dyn Fn(&Shape) -> bool| -> Vec<usize> {
+            movable
+                .iter()
+                .copied()
+                .filter(|&i| keep(&scene.occluders[i].shape))
+                .collect()
+        };
+        let blocks = of(&fits_pose);
+        let meshes = of(&|s| matches!(s, Shape::Mesh(_)));
+        Bodies {
+            movable,
+            blocks,
+            meshes,
+        }
+    }
+}
+
+/// The pairs of `movable` bodies that could exchange pose and place.
+fn exchange_pairs(scene: &crate::scene::Scene, movable: &[usize]) -> usize {
+    movable
+        .iter()
+        .enumerate()
+        .map(|(a, &i)| {
+            movable[a + 1..]
+                .iter()
+                .filter(|&&j| exchangeable(scene, i, j))
+                .count()
+        })
+        .sum()
 }
 
 /// Slide the [`POLISHED`] best of `offers` (sorted best first; those of one body only

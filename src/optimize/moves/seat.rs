@@ -7,7 +7,8 @@
 
 use glam::{DQuat, DVec3};
 
-use super::pose::{self, fit_and_launch, Seats, SEAT_KEPT, SEAT_PAIRS};
+use super::pose::{fit_and_launch, SEAT_KEPT, SEAT_PAIRS};
+use super::seats::{self, Seats};
 use super::sight::exchangeable;
 use super::spin::{launch_to, spin_guesses};
 use super::{Move, Offers, Round, TRADE_SLACK};
@@ -84,9 +85,9 @@ impl Move for Seat {
         for group in r.trades {
             let of_meshes = matches!(shape(group[0]), Shape::Mesh(_));
             let (cap, slack) = if of_meshes {
-                (pose::MESH_TRADES, TRADE_SLACK)
+                (seats::MESH_TRADES, TRADE_SLACK)
             } else {
-                (pose::TRADES, 1)
+                (seats::TRADES, 1)
             };
             let first = out.list.len();
             for cycle in seats.trade_scan(group, cap, out.ws) {

@@ -4,7 +4,7 @@
 //! guards, as data, with the table of thresholds), [`Observer`] (how the caller
 //! watches and saves: the CLI draws progress bars, writes previews and saves after
 //! every stage; this module touches no file), [`Solution`] (what `solution.json`
-//! holds, with a [`PassRecord`](crate::output::solution::PassRecord) for every pass that ran) and [`SampleRecord`] (one row
+//! holds, with a [`PassRecord`] for every pass that ran) and [`SampleRecord`] (one row
 //! of `convergence.csv`).
 //!
 //! Data flow of [`solve`]: attempts ([`Schedule::attempts`]) of [`attempt`]; an
@@ -34,13 +34,13 @@ use std::time::Instant;
 
 pub use schedule::Schedule;
 use search::{stop_name, Pool};
-use stage::StageRun;
+use stage::{StageEnd, StageRun};
 
 use crate::energy::{Term, Weights};
-use crate::evaluate::{Physics, Problem, Workspace};
+use crate::evaluate::{Held, Physics, Problem, Workspace};
 use crate::output::solution::{
-    AttemptRecord, FrameRecord, OccluderLaunch, RobustRecord, SampleRecord, Solution, StageReport,
-    TermValue,
+    AttemptRecord, FrameRecord, OccluderLaunch, PassRecord, RobustRecord, SampleRecord, Solution,
+    StageReport, TermValue,
 };
 use crate::scene::{Launch, Stage};
 use crate::shadow::mask::Mask;
@@ -243,6 +243,88 @@ impl Observer for LaterAttempt<'_> {
     }
 }
 
+/// Where an attempt begins: the start guess, or a saved solution's launch and the
+/// records of its completed stages (a stage that a stop cut short runs again, from the
+/// saved best).
+struct Begun {
+    params: Vec<f64>,
+    first_stage: usize,
+    reports: Vec<StageReport>,
+    passes: Vec<PassRecord>,
+    prior_time: f64,
+}
+
+impl Begun {
+    fn of(problem: &Problem, resume: Option<&Solution>) -> Begun {
+        match resume {
+            Some(s) => {
+                let done = s.stages_completed.min(s.stages.len());
+                Begun {
+                    params: resume_parameters(problem, s),
+                    first_stage: s.stages_completed,
+                    reports: s.stages[..done].to_vec(),
+                    passes: s
+                        .passes
+                        .iter()
+                        .filter(|p| p.stage < done)
+                        .cloned()
+                        .collect(),
+                    prior_time: s.wall_time_s,
+                }
+            }
+            None => Begun {
+                params: problem.start_parameters(),
+                first_stage: 0,
+                reports: Vec::new(),
+                passes: Vec::new(),
+                prior_time: 0.0,
+            },
+        }
+    }
+}
+
+/// What `stage` holds fixed, computed once (a sample only pays for what varies) from
+/// `params`. Bodies no stage has moved yet (`unplaced`, updated) are still at their
+/// start guess: the bodies being placed need not go around them (they will move), only
+/// around those placed.
+fn held_for(problem: &Problem, params: &[f64], stage: &Stage, unplaced: &mut [bool]) -> Held {
+    let mut held = problem.hold(params, &stage.vary).for_stage(stage);
+    held.ignore_contacts_with(unplaced);
+    for &i in &stage.vary {
+        unplaced[i] = false;
+    }
+    held
+}
+
+/// The report of `stage`, begun at `started`, as it ended (`stopped`: by a second
+/// interrupt).
+fn stage_report(stage: &Stage, end: &StageEnd, stopped: bool, started: Instant) -> StageReport {
+    let stop = if stopped {
+        stop_name(end.stop, end.interrupted, true)
+    } else {
+        let mut text = match end.out_of_time {
+            true => "time limit".to_string(),
+            false => stop_name(end.stop, end.interrupted, false),
+        };
+        text.push_str(end.polish.as_deref().unwrap_or(""));
+        if end.kept_start {
+            text.push_str("; kept its start, the better picture");
+        }
+        text
+    };
+    StageReport {
+        name: stage.name.clone(),
+        iterations: end.iterations,
+        samples: end.samples,
+        population: end.population,
+        restarts: end.restarts,
+        best_energy: end.eval.total,
+        iou: end.eval.iou,
+        stop,
+        wall_time_s: started.elapsed().as_secs_f64(),
+    }
+}
+
 /// One attempt (`a`, counted from 0): the stages from the start guess (or from a
 /// resumed solution) with `seed`, each through the schedule's passes, until the
 /// `deadline` if any.
@@ -265,25 +347,13 @@ fn attempt(
     let pool = Pool::new(problem, threads);
     let start = Instant::now();
     let mut records = Vec::new();
-    let (mut params, first_stage, mut reports, mut passes, prior_time) = match &options.resume {
-        // Reports of a stage that a stop cut short are dropped: that stage runs again,
-        // starting from the saved best.
-        Some(s) => {
-            let done = s.stages_completed.min(s.stages.len());
-            (
-                resume_parameters(problem, s),
-                s.stages_completed,
-                s.stages[..done].to_vec(),
-                s.passes
-                    .iter()
-                    .filter(|p| p.stage < done)
-                    .cloned()
-                    .collect(),
-                s.wall_time_s,
-            )
-        }
-        None => (problem.start_parameters(), 0, Vec::new(), Vec::new(), 0.0),
-    };
+    let Begun {
+        mut params,
+        first_stage,
+        mut reports,
+        mut passes,
+        prior_time,
+    } = Begun::of(problem, options.resume.as_ref());
     let mut aborted = false;
     // Occluders that no stage has varied yet (a resumed solve has varied those of its
     // completed stages).
@@ -310,14 +380,7 @@ fn attempt(
         }
         observer.stage_started(k, stage);
         let stage_start = Instant::now();
-        // What the stage holds fixed, computed once: a sample only pays for what varies.
-        let mut held = problem.hold(&params, &stage.vary).for_stage(stage);
-        // Bodies no stage has moved yet are still at their start guess: the body being
-        // placed need not go around them (they will move), only around those placed.
-        held.ignore_contacts_with(&unplaced);
-        for &i in &stage.vary {
-            unplaced[i] = false;
-        }
+        let held = held_for(problem, &params, stage, &mut unplaced);
         let mut run = StageRun::new(
             problem,
             &pool,
@@ -335,33 +398,11 @@ fn attempt(
         run.attempt = a;
         run.deadline = deadline;
         let end = run.run(&options.schedule);
-        let mut stop_text = if end.out_of_time {
-            "time limit".to_string()
-        } else {
-            stop_name(end.stop, end.interrupted, false)
-        };
-        stop_text.push_str(end.polish.as_deref().unwrap_or(""));
-        if end.kept_start {
-            stop_text.push_str("; kept its start, the better picture");
-        }
         params.copy_from_slice(&end.launch);
         // A second interrupt during the stage stops the solve: the stage does not count
         // as completed, so that `--resume` runs it again from the best so far.
         let stopped = end.interrupted && interrupts.load(Ordering::SeqCst) >= 2;
-        if stopped {
-            stop_text = stop_name(end.stop, end.interrupted, stopped);
-        }
-        reports.push(StageReport {
-            name: stage.name.clone(),
-            iterations: end.iterations,
-            samples: end.samples,
-            population: end.population,
-            restarts: end.restarts,
-            best_energy: end.eval.total,
-            iou: end.eval.iou,
-            stop: stop_text,
-            wall_time_s: stage_start.elapsed().as_secs_f64(),
-        });
+        reports.push(stage_report(stage, &end, stopped, stage_start));
         let run = Run {
             seed,
             stages_completed: if stopped { k } else { k + 1 },
@@ -378,46 +419,57 @@ fn attempt(
         }
         if end.out_of_time {
             // The stages left are skipped: the solve is complete at its time limit.
-            for skipped in &scene.stages[k + 1..] {
-                reports.push(StageReport {
-                    name: skipped.name.clone(),
-                    iterations: 0,
-                    samples: 0,
-                    population: 0,
-                    restarts: 0,
-                    best_energy: end.eval.total,
-                    iou: end.eval.iou,
-                    stop: "skipped (time limit)".into(),
-                    wall_time_s: 0.0,
-                });
-            }
+            reports.extend(scene.stages[k + 1..].iter().map(|skipped| StageReport {
+                name: skipped.name.clone(),
+                iterations: 0,
+                samples: 0,
+                population: 0,
+                restarts: 0,
+                best_energy: end.eval.total,
+                iou: end.eval.iou,
+                stop: "skipped (time limit)".into(),
+                wall_time_s: 0.0,
+            }));
             break;
         }
     }
-    // A stage cut short by a stop is reported but not completed.
-    let completed = reports.len()
-        - usize::from(
-            aborted
-                && reports
-                    .last()
-                    .is_some_and(|r| r.stop.starts_with("stopped")),
-        );
-    let wall = prior_time + start.elapsed().as_secs_f64();
-    let complete = !aborted
-        && completed == scene.stages.len()
-        && reports.iter().all(|r| !r.stop.starts_with("interrupted"));
-    let mut ws = problem.workspace();
-    let timing = problem.profile(&params, profile_reps(problem, &params, &mut ws), &mut ws);
     let run = Run {
         seed,
-        stages_completed: completed,
-        complete,
-        wall_time_s: wall,
+        stages_completed: 0,
+        complete: false,
+        wall_time_s: prior_time + start.elapsed().as_secs_f64(),
         threads,
     };
-    let mut s = summarize(problem, &params, &reports, &run, Some(timing));
+    (
+        finish(problem, &params, &reports, passes, aborted, run),
+        records,
+    )
+}
+
+/// The solution of an attempt that ran `reports` (`aborted` by a stop) to `params`,
+/// with its per-phase profile: a stage cut short by a stop is reported but not
+/// completed, and an attempt is complete when every stage ran to its own stop.
+fn finish(
+    problem: &Problem,
+    params: &[f64],
+    reports: &[StageReport],
+    passes: Vec<PassRecord>,
+    aborted: bool,
+    mut run: Run,
+) -> Solution {
+    let cut = aborted
+        && reports
+            .last()
+            .is_some_and(|r| r.stop.starts_with("stopped"));
+    run.stages_completed = reports.len() - usize::from(cut);
+    run.complete = !aborted
+        && run.stages_completed == problem.scene.stages.len()
+        && reports.iter().all(|r| !r.stop.starts_with("interrupted"));
+    let mut ws = problem.workspace();
+    let timing = problem.profile(params, profile_reps(problem, params, &mut ws), &mut ws);
+    let mut s = summarize(problem, params, reports, &run, Some(timing));
     s.passes = passes;
-    (s, records)
+    s
 }
 
 /// Repetitions of the per-phase profile in `solution.json`: as many as fit in about
