@@ -445,55 +445,21 @@ fn table(name: &str) -> String {
     }
 }
 
-/// The fields of a CSV file's lines: comma-separated, a field in double quotes may hold
-/// commas and doubled quotes (RFC 4180, no line breaks within a field).
+/// The fields of a CSV file's lines (RFC 4180: a field in double quotes may hold commas
+/// and doubled quotes).
 fn csv_rows(text: &str, what: &str) -> Vec<Vec<String>> {
-    let mut rows = Vec::new();
-    for (k, line) in text.lines().enumerate() {
-        if line.trim().is_empty() {
-            continue;
-        }
-        let at = || format!("{what} line {}: {line}", k + 1);
-        let mut fields = Vec::new();
-        let mut chars = line.chars().peekable();
-        loop {
-            let mut field = String::new();
-            if chars.peek() == Some(&'"') {
-                chars.next();
-                loop {
-                    match chars.next() {
-                        Some('"') if chars.peek() == Some(&'"') => {
-                            chars.next();
-                            field.push('"');
-                        }
-                        Some('"') => break,
-                        Some(c) => field.push(c),
-                        None => panic!("{}: an unclosed quote", at()),
-                    }
-                }
-                assert!(
-                    matches!(chars.peek(), None | Some(',')),
-                    "{}: text after a closing quote",
-                    at()
-                );
-            } else {
-                while let Some(&c) = chars.peek() {
-                    if c == ',' {
-                        break;
-                    }
-                    assert!(c != '"', "{}: a quote in an unquoted field", at());
-                    field.push(c);
-                    chars.next();
-                }
-            }
-            fields.push(field);
-            if chars.next().is_none() {
-                break;
-            }
-        }
-        rows.push(fields);
-    }
-    rows
+    csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(text.as_bytes())
+        .records()
+        .map(|r| {
+            r.unwrap_or_else(|e| panic!("{what}: {e}"))
+                .iter()
+                .map(String::from)
+                .collect()
+        })
+        .collect()
 }
 
 /// A table as recorded in `results/tables/NAME.csv`: the first row its headers, every
