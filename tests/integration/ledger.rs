@@ -2,6 +2,11 @@
 //! and `<!-- end -->` is made from the CSV files of `results/`, which the suites append
 //! rows to (`scripts/ledger.sh`). `BSA_REGENERATE=1 cargo test --test integration
 //! ledger::` writes the tables; without it the test fails when they differ.
+//!
+//! A table the ledger does not derive (a measurement recorded once, with its commit in
+//! a column or in the text around it) is `results/tables/NAME.csv`: its first row the
+//! column headers, each further row a row of the table, every cell as the page shows
+//! it. No table of the page lies outside the markers.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -436,8 +441,89 @@ fn table(name: &str) -> String {
         "planted" => table_planted(),
         "new-suite" => table_new_suite(),
         "new-suite-latest" => table_new_suite_latest(),
-        other => panic!("docs/results.md names an unknown table {other:?}"),
+        other => table_as_recorded(other),
     }
+}
+
+/// The fields of a CSV file's lines (RFC 4180: a field in double quotes may hold commas
+/// and doubled quotes).
+fn csv_rows(text: &str, what: &str) -> Vec<Vec<String>> {
+    csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(text.as_bytes())
+        .records()
+        .map(|r| {
+            r.unwrap_or_else(|e| panic!("{what}: {e}"))
+                .iter()
+                .map(String::from)
+                .collect()
+        })
+        .collect()
+}
+
+/// A table as recorded in `results/tables/NAME.csv`: the first row its headers, every
+/// cell as shown (an empty cell as one space).
+fn table_as_recorded(name: &str) -> String {
+    let path = root().join(format!("results/tables/{name}.csv"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| {
+        panic!(
+            "docs/results.md names the table {name:?}, which is neither made from the ledger nor in {}: {e}",
+            path.display()
+        )
+    });
+    let rows = csv_rows(&text, &path.display().to_string());
+    let width = rows.first().map_or(0, Vec::len);
+    assert!(width > 0, "{}: no header row", path.display());
+    let line = |cells: &[String]| {
+        let mut s = String::from("|");
+        for c in cells {
+            assert!(
+                !c.contains('|'),
+                "{}: a cell holds '|': {c}",
+                path.display()
+            );
+            if c.is_empty() {
+                s.push_str(" |");
+            } else {
+                let _ = write!(s, " {c} |");
+            }
+        }
+        s.push('\n');
+        s
+    };
+    let mut t = line(&rows[0]);
+    t.push_str(&"|---".repeat(width));
+    t.push_str("|\n");
+    for r in &rows[1..] {
+        assert_eq!(
+            r.len(),
+            width,
+            "{}: a row of {} cells under {width} headers: {r:?}",
+            path.display(),
+            r.len()
+        );
+        t.push_str(&line(r));
+    }
+    t
+}
+
+/// The lines of `text` that start a markdown table row (`|`) outside every
+/// `<!-- table:NAME -->` ... `<!-- end -->` block, with their line numbers.
+fn table_lines_outside_markers(text: &str) -> Vec<(usize, &str)> {
+    let mut inside = false;
+    let mut out = Vec::new();
+    for (k, line) in text.lines().enumerate() {
+        let t = line.trim_start();
+        if t.starts_with("<!-- table:") {
+            inside = true;
+        } else if t.starts_with("<!-- end -->") {
+            inside = false;
+        } else if t.starts_with('|') && !inside {
+            out.push((k + 1, line));
+        }
+    }
+    out
 }
 
 /// `text` with every marked table made again from the ledger.
@@ -480,6 +566,51 @@ fn docs_results_md_tables_are_the_ledger() {
         &made,
         "docs/results.md's tables differ from the ledger (results/*.csv)",
         "cargo test --test integration ledger::",
+    );
+}
+
+#[test]
+fn every_table_of_docs_results_md_is_between_markers() {
+    let text = std::fs::read_to_string(root().join("docs/results.md")).unwrap();
+    let outside = table_lines_outside_markers(&text);
+    assert!(
+        outside.is_empty(),
+        "docs/results.md has table lines outside <!-- table:NAME --> ... <!-- end --> \
+         (put the table in results/tables/NAME.csv and mark it):\n{}",
+        outside
+            .iter()
+            .map(|(n, l)| format!("{n}: {l}"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
+    assert_eq!(
+        table_lines_outside_markers("| a |\n<!-- table:x -->\n| b |\n<!-- end -->\n| c |\n"),
+        [(1, "| a |"), (5, "| c |")]
+    );
+}
+
+#[test]
+fn every_recorded_table_is_on_the_page_and_reads_back() {
+    let page = std::fs::read_to_string(root().join("docs/results.md")).unwrap();
+    let dir = root().join("results/tables");
+    let mut files = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "csv") {
+            continue;
+        }
+        files += 1;
+        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        assert!(
+            page.contains(&format!("<!-- table:{name} -->")),
+            "results/tables/{name}.csv is not on docs/results.md"
+        );
+        table_as_recorded(&name);
+    }
+    assert!(files > 0, "results/tables holds no table");
+    assert_eq!(
+        csv_rows("a,\"b, \"\"c\"\"\",\n,x,\n", "test"),
+        [vec!["a", "b, \"c\"", ""], vec!["", "x", ""]]
     );
 }
 
