@@ -21,6 +21,14 @@ use crate::geometry::shape::{self, MassProperties, Shape};
 use crate::shadow::mask::Mask;
 use crate::shadow::raster::ShadowCamera;
 
+/// "does not exist", or "cannot be read: <the system's reason>".
+fn unreadable(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "does not exist".to_string(),
+        _ => format!("cannot be read: {e}"),
+    }
+}
+
 /// Why a scene could not be loaded. Every variant names the file, and the field when
 /// one is at fault, so that the message alone tells the user what to fix.
 #[derive(Debug, thiserror::Error)]
@@ -31,6 +39,15 @@ pub enum SceneError {
         path: PathBuf,
         #[source]
         source: std::io::Error,
+    },
+    /// A file that a field of the scene names could not be read: both files are named,
+    /// and whether the named one is missing or unreadable (with the system's reason).
+    #[error("{path}: field `{field}` names {}, which {}", .named.display(), unreadable(.error))]
+    Named {
+        path: PathBuf,
+        field: String,
+        named: PathBuf,
+        error: std::io::Error,
     },
     /// The scene file is not valid JSON, has an unknown field, or a value of the wrong type.
     #[error("{path}: {message}")]

@@ -37,7 +37,7 @@ impl Validator<'_> {
             })?;
             let t = self.instant("t", t)?;
             return Ok(vec![PictureSpec {
-                target: self.target(rel)?,
+                target: self.target("target", rel)?,
                 file: self.resolve(rel),
                 t,
                 weight: 1.0,
@@ -87,7 +87,7 @@ impl Validator<'_> {
             if weight == 0.0 {
                 return Err(self.field_err(f("weight"), "must be positive"));
             }
-            let target = self.target(rel)?;
+            let target = self.target(&f("target"), rel)?;
             if let Some(first) = out.first() {
                 let (w, h) = (first.target.width(), first.target.height());
                 if (target.width(), target.height()) != (w, h) {
@@ -131,7 +131,9 @@ impl Validator<'_> {
                     .enumerate()
                     .map(|(i, h)| self.hint(&format!("{field}[{i}]"), h, occluders))
                     .collect::<Result<_>>()?,
-                Some((RawHints::File(rel), _)) => self.hints_file(&self.resolve(rel), occluders)?,
+                Some((RawHints::File(rel), field)) => {
+                    self.hints_file(&field, &self.resolve(rel), occluders)?
+                }
             };
             pictures.push(Picture {
                 target: spec.target,

@@ -301,11 +301,13 @@ impl Validator<'_> {
         })
     }
 
-    pub(super) fn target(&self, rel: &str) -> Result<Mask> {
+    pub(super) fn target(&self, field: &str, rel: &str) -> Result<Mask> {
         let path = self.resolve(rel);
-        let bytes = super::read_input(&path).map_err(|source| SceneError::Io {
-            path: path.clone(),
-            source,
+        let bytes = super::read_input(&path).map_err(|error| SceneError::Named {
+            path: self.file.to_path_buf(),
+            field: field.to_string(),
+            named: path.clone(),
+            error,
         })?;
         let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
             .map_err(|e| SceneError::TargetNotPng {
@@ -592,10 +594,17 @@ impl Validator<'_> {
 
     /// Hints in a text file, one per line: `occluder x y z px py [weight]`; `#` starts a
     /// comment. This is the paper's "hints stored separately in a text file".
-    pub(super) fn hints_file(&self, path: &Path, occ: &[Occluder]) -> Result<Vec<Hint>> {
-        let text = super::read_input_text(path).map_err(|source| SceneError::Io {
-            path: path.to_path_buf(),
-            source,
+    pub(super) fn hints_file(
+        &self,
+        field: &str,
+        path: &Path,
+        occ: &[Occluder],
+    ) -> Result<Vec<Hint>> {
+        let text = super::read_input_text(path).map_err(|error| SceneError::Named {
+            path: self.file.to_path_buf(),
+            field: field.to_string(),
+            named: path.to_path_buf(),
+            error,
         })?;
         let mut out = Vec::new();
         for (k, line) in text.lines().enumerate() {

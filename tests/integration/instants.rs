@@ -104,7 +104,15 @@ fn bad_sequences_are_refused_naming_the_field() {
         "seq-missing",
         serde_json::json!([{"target": "target.png", "t": 0.8}, {"target": "nowhere.png", "t": 1.2}]),
     );
-    rejected(&d, &["nowhere.png", "cannot read"]);
+    rejected(
+        &d,
+        &[
+            "scene.json",
+            "targets[1].target",
+            "nowhere.png",
+            "which does not exist",
+        ],
+    );
     let d = sequence_variant(
         "seq-no-target",
         serde_json::json!([{"target": "target.png", "t": 0.8}, {"t": 1.2}]),

@@ -37,6 +37,34 @@ fn malformed_json_and_unknown_fields_are_refused() {
 }
 
 #[test]
+fn a_file_the_scene_names_is_refused_naming_the_scene_the_field_and_the_file() {
+    // Missing: the scene, its field and the file it names.
+    let d = variant("target-missing", |v| v["target"] = "nowhere.png".into());
+    assert_rejected(
+        &d,
+        &[
+            "scene.json",
+            "field `target`",
+            "nowhere.png",
+            "does not exist",
+        ],
+    );
+    // There but unreadable (a folder: even root cannot read it as a file): said so, with
+    // the system's reason.
+    let d = variant("hints-unreadable", |v| v["hints"] = "hints.txt".into());
+    std::fs::create_dir(d.join("hints.txt")).unwrap();
+    assert_rejected(
+        &d,
+        &[
+            "scene.json",
+            "field `hints`",
+            "hints.txt",
+            "cannot be read: ",
+        ],
+    );
+}
+
+#[test]
 fn occluder_named_after_an_export_node_is_refused_at_load() {
     // An occluder named after a node of the glTF export: refused when the scene is
     // loaded, not after the solve when the export runs.
