@@ -278,20 +278,26 @@ fn table_make_examples() -> String {
     t
 }
 
+/// The last `n` runs of a suite in the ledger's order, each named by its commit, set or
+/// seed, and route.
+fn last_runs(rows: &[Row], n: usize) -> Vec<(String, String, String)> {
+    let mut runs: Vec<(String, String, String)> = Vec::new();
+    for r in rows {
+        let key = (r.commit.clone(), r.set_or_seed.clone(), r.route.clone());
+        if !runs.contains(&key) {
+            runs.push(key);
+        }
+    }
+    runs.split_off(runs.len().saturating_sub(n))
+}
+
 /// The last planted draws: per class the median and lowest IoU and the median wall time.
 /// A draw's rows are one per problem (item `<class> <seed>`) or, where only the summary
 /// was kept, `<class> median` and `<class> lowest`.
 fn table_planted() -> String {
     let rows = ledger("planted");
-    let mut draws: Vec<(String, String, String)> = Vec::new();
-    for r in &rows {
-        let key = (r.commit.clone(), r.set_or_seed.clone(), r.route.clone());
-        if !draws.contains(&key) {
-            draws.push(key);
-        }
-    }
     // The last draws only, so that the page stays short as the ledger grows.
-    let draws = draws.split_off(draws.len().saturating_sub(LAST_DRAWS));
+    let draws = last_runs(&rows, LAST_DRAWS);
     let mut t = String::from(
         "| draw (first seed) | route | class | problems | median IoU | lowest IoU | contact before t | median wall time | commit |\n|---|---|---|---|---|---|---|---|---|\n",
     );
@@ -358,14 +364,7 @@ fn table_planted() -> String {
 /// The last runs of the `bsa new` suite: a set and seed, stated objects or `auto:`.
 fn table_new_suite() -> String {
     let rows = ledger("new-suite");
-    let mut runs: Vec<(String, String, String)> = Vec::new();
-    for r in &rows {
-        let key = (r.commit.clone(), r.set_or_seed.clone(), r.route.clone());
-        if !runs.contains(&key) {
-            runs.push(key);
-        }
-    }
-    let runs = runs.split_off(runs.len().saturating_sub(LAST_RUNS));
+    let runs = last_runs(&rows, LAST_RUNS);
     let mut t = String::from(
         "| set / seed | objects | pictures | median IoU | lowest IoU | at 0.90 or more | with a contact before t | commit |\n|---|---|---|---|---|---|---|---|\n",
     );
