@@ -7,8 +7,9 @@
 //! [`sim`] (exact free flight, first contacts, rapier after `t`, air drag) ->
 //! [`shadow`] (exact shadow into a [`shadow::mask::Mask`]) -> [`energy`] (the paper's
 //! ten terms) -> [`evaluate`] (one sample) -> [`optimize`] (stages of CMA-ES) ->
-//! [`output`] (the result schema and files) and [`budget`] (the error budget); [`cli`]
-//! is the glue of the `bsa` binary.
+//! [`output`] (the result schema and files), [`budget`] (the error budget) and
+//! [`compose`] (`bsa new`'s design search, over [`design`]); [`cli`] is the glue of the
+//! `bsa` binary.
 //!
 //! The modules' docs are written for the developers and name private items (a stage's
 //! constants, its helpers); `cargo doc --document-private-items` renders those links.
@@ -17,6 +18,7 @@
 
 pub mod budget;
 pub mod cli;
+pub mod compose;
 pub mod design;
 pub mod energy;
 pub mod evaluate;

@@ -6,9 +6,9 @@
 use std::path::{Path, PathBuf};
 
 /// The library's top-level modules, lowest layer first.
-const LAYERS: [&str; 12] = [
+const LAYERS: [&str; 13] = [
     "linalg", "geometry", "shadow", "energy", "scene", "sim", "evaluate", "design", "output",
-    "optimize", "budget", "cli",
+    "optimize", "budget", "compose", "cli",
 ];
 
 fn rank(module: &str) -> Option<usize> {

@@ -6,17 +6,9 @@
 //! target. Everything the user reads (the start IoU, a contact) comes from the scene
 //! file as written, loaded afresh.
 //!
-//! The design is made under each of [`design::CEILINGS`] in each of [`design::ORDERS`];
-//! by default ([`ChooseBy::Solve`]) the designs that differ from those before them
-//! then race: each is solved as `bsa solve` will solve it (the scene's seed, the
-//! scene's strategy, [`Schedule::TRIAL`]) to a quarter of its stages, the better half
-//! goes on to half of them, the better half of those to the end ([`race`]), and the
-//! one whose solve ends at the best picture, contact-free first, is written. A start
-//! guess's IoU says little of where its solve ends: on 27 held-out pictures the design
-//! with the best start was the best solved one for 12. When no
-//! trial reaches [`design::REPLACE_BELOW`], a second [`Round`] designs every setting
-//! again with its objects placed anew ([`design::cover::Cover::replace`]) and solves
-//! those, and the best of both rounds is written.
+//! The design search ([`crate::compose`]) designs the picture under every
+//! setting and, by default ([`ChooseBy::Solve`]), races the designs by their trial
+//! solves; the best is written.
 //!
 //! Until the scene is written, `bsa new` works in scratch files in the folder (a copy of
 //! the target, the first scene, one scene per design; [`Scratch`] removes them however
@@ -28,19 +20,17 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use anyhow::{bail, Context, Result};
-use rayon::prelude::*;
 use serde_json::{json, Value};
 
+use crate::compose::{self, Scenes, Search, SearchError, Solved, Variant, Watch};
 use crate::design::inventory::{Auto, AutoKind, Inventory, Kind};
 use crate::design::launch::{Geometry, Object, Plan};
 use crate::design::picture::Picture;
 use crate::design::plant::{default_strategy, Stage};
-use crate::design::{self, chess, separate, AutoRequest, DesignError, Order, Request};
+use crate::design::{self, chess, AutoRequest, DesignError, Request};
 use crate::energy::Weights;
 use crate::evaluate::Problem;
-use crate::optimize::solver::{self, Schedule, Silent, SolveOptions};
 use crate::output::files;
-use crate::output::solution::Solution;
 use crate::scene::{Contacts, Scene, SceneError};
 
 use super::guard::NothingWritten;
@@ -244,23 +234,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let created = !dir.exists();
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let probe_file = dir.join(SCRATCH_PROBE);
-    // Every (order, ceiling) the design is made under, orders outermost: first as
-    // greedy, exchanged and polished; then, in the second round, with every object
-    // placed anew too (`Setting::replace`).
-    let settings: Vec<Setting> = [false, true]
-        .into_iter()
-        .flat_map(|replace| {
-            design::ORDERS.iter().flat_map(move |&order| {
-                design::CEILINGS.iter().map(move |&ceiling| Setting {
-                    order,
-                    ceiling,
-                    replace,
-                })
-            })
-        })
-        .collect();
-    let first_round = design::ORDERS.len() * design::CEILINGS.len();
-    let design_files: Vec<PathBuf> = (0..settings.len())
+    let design_files: Vec<PathBuf> = (0..compose::settings().len())
         .map(|k| dir.join(format!(".bsa-new-design-{k}.json")))
         .collect();
     let scratch = Scratch::new(
@@ -305,88 +279,28 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         return Err(e);
     }
     check_dark_part(&scene, &protos, &opts.target)?;
-    let objects: Vec<Object> = protos
-        .iter()
-        .zip(&scene.occluders)
-        .map(|(p, o)| Object {
-            stem: p.stem.clone(),
-            shape: o.shape.clone(),
-            shape_json: p.shape.clone(),
-            density: p.density,
-        })
-        .collect();
-    let request = Request {
-        fixed: of_item.iter().map(|&k| objects[k].clone()).collect(),
-        auto: opts.inventory.auto.as_ref().map(|a| match a.kind {
-            AutoKind::Sphere { radius: None } => AutoRequest::Spheres { density: a.density },
-            _ => AutoRequest::Objects(auto.iter().map(|&(k, n)| (objects[k].clone(), n)).collect()),
-        }),
-    };
-    let mask = &scene.target;
-    let (w, h) = (mask.width(), mask.height());
-    let picture = Picture::new(w, h, (0..w * h).map(|k| mask.get(k % w, k / w)).collect());
-    let geometry = Geometry {
-        camera: scene.camera.clone(),
-        table_top: scene.table.as_ref().map_or(0.0, |t| t.top()),
-        gravity: scene.gravity,
-        t: scene.t,
-        ceiling: design::CEILINGS[0],
-    };
-    // One design per order and ceiling, in parallel, each written to its own file
-    // beside the scene (mesh paths are relative to the folder) and made contact-free;
-    // then, by default, each design that differs from the others is solved. The best
-    // (see `Variant::better_than`) is kept.
+    let request = request_of(&scene, &protos, (&of_item, &auto), &opts.inventory);
+    let (picture, geometry) = picture_and_geometry(&scene);
+    // One design per setting, in parallel, each written to its own file beside the
+    // scene (mesh paths are relative to the folder) and made contact-free; then, by
+    // default, the designs that differ race, and the best is kept.
     let trial = opts.choose_by == ChooseBy::Solve;
-    let round = Round {
+    let mut found = Search {
         picture: &picture,
         geometry: &geometry,
         request: &request,
-        settings: &settings,
-        files: &design_files,
+        scenes: &DesignFiles(&design_files),
         name: &name,
+        target: SCRATCH_TARGET,
         seed: opts.seed,
         trial,
-    };
-    let mut designed: Vec<Result<Variant>> = Vec::new();
-    let mut same_as: Vec<Option<usize>> = Vec::new();
-    round.run(0..first_round, &mut designed, &mut same_as);
-    // When no trial solve reaches `design::REPLACE_BELOW`, every setting is designed
-    // again with its objects placed anew, and the best of both rounds is kept.
-    let best_trial = designed
-        .iter()
-        .filter_map(|v| v.as_ref().ok()?.solved)
-        .filter(|s| s.clear && s.finished())
-        .map(|s| s.iou)
-        .fold(f64::NEG_INFINITY, f64::max);
-    if trial && best_trial < design::REPLACE_BELOW && INTERRUPTS.load(Ordering::SeqCst) == 0 {
-        round.run(first_round..settings.len(), &mut designed, &mut same_as);
     }
+    .run(&Bars::default(), &INTERRUPTS);
     if INTERRUPTS.load(Ordering::SeqCst) > 0 {
         return Err(NothingWritten {
             dir: dir.display().to_string(),
         }
         .into());
-    }
-    let mut best: Option<Variant> = None;
-    let mut first_error = None;
-    // Each design's trial, for the line that reports them.
-    let mut seen: Vec<Trial> = Vec::new();
-    for (k, v) in designed.into_iter().enumerate() {
-        match v {
-            Ok(v) => {
-                seen.push(match same_as[k] {
-                    Some(_) => Trial::Same,
-                    None => Trial::Solved(v.solved),
-                });
-                if best.as_ref().is_none_or(|b| v.better_than(b)) {
-                    best = Some(v);
-                }
-            }
-            Err(e) => {
-                seen.push(Trial::Failed);
-                first_error.get_or_insert(e);
-            }
-        }
     }
     let Some(Variant {
         plan,
@@ -394,9 +308,14 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         solved,
         setting,
         ..
-    }) = best
+    }) = found.best.take()
     else {
-        let err = first_error.expect("every setting gave a design or an error");
+        let err = match found.first_error.take() {
+            Some(SearchError::Design(e)) => e.into(),
+            Some(SearchError::Scenes(e)) => anyhow::Error::from_boxed(e),
+            Some(e) => e.into(),
+            None => unreachable!("every setting gave a design or an error"),
+        };
         return Err(design_in_users_terms(err, opts, &scene, &protos, &of_item));
     };
     // The folder's scene is replaced only now, target first: a scene.json is never left
@@ -408,9 +327,67 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     )?;
     scratch.written();
     if trial {
-        println!("{name}: {}", trials_line(&seen, setting));
+        println!("{name}: {}", found.trials_line(setting));
     }
     // What the user gets: the scene as written, loaded afresh.
+    tell_written(opts, &name, &plan, moves, solved)
+}
+
+/// The design's request: the list's fixed items as objects (each its prototype's
+/// shape as the first scene loaded it), and the `auto:` kind's (`auto`: prototype and
+/// count of each).
+fn request_of(
+    scene: &Scene,
+    protos: &[Prototype],
+    (of_item, auto): (&[usize], &[(usize, usize)]),
+    inventory: &Inventory,
+) -> Request {
+    let objects: Vec<Object> = protos
+        .iter()
+        .zip(&scene.occluders)
+        .map(|(p, o)| Object {
+            stem: p.stem.clone(),
+            shape: o.shape.clone(),
+            shape_json: p.shape.clone(),
+            density: p.density,
+        })
+        .collect();
+    Request {
+        fixed: of_item.iter().map(|&k| objects[k].clone()).collect(),
+        auto: inventory.auto.as_ref().map(|a| match a.kind {
+            AutoKind::Sphere { radius: None } => AutoRequest::Spheres { density: a.density },
+            _ => AutoRequest::Objects(auto.iter().map(|&(k, n)| (objects[k].clone(), n)).collect()),
+        }),
+    }
+}
+
+/// The first scene's target as the design reads it, and its camera, table, gravity
+/// and `t`.
+fn picture_and_geometry(scene: &Scene) -> (Picture, Geometry) {
+    let mask = &scene.target;
+    let (w, h) = (mask.width(), mask.height());
+    let picture = Picture::new(w, h, (0..w * h).map(|k| mask.get(k % w, k / w)).collect());
+    let geometry = Geometry {
+        camera: scene.camera.clone(),
+        table_top: scene.table.as_ref().map_or(0.0, |t| t.top()),
+        gravity: scene.gravity,
+        t: scene.t,
+        ceiling: design::CEILINGS[0],
+    };
+    (picture, geometry)
+}
+
+/// Tell the user what was written: the scene as written, loaded afresh, its start
+/// guess drawn into `start.png`, a line of what it holds and, when the objects leave
+/// much of the picture bare, a note.
+fn tell_written(
+    opts: &Options,
+    name: &str,
+    plan: &Plan,
+    moves: usize,
+    solved: Option<Solved>,
+) -> Result<()> {
+    let dir = &opts.dir;
     let problem = Problem::new(load::scene(dir)?);
     let mut ws = problem.workspace();
     let start = problem.evaluate(
@@ -464,13 +441,36 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     Ok(())
 }
 
-/// `work()`, unless Ctrl-C was pressed: after it nothing is written, so the designs and
-/// trial solves not yet begun are skipped.
-fn unless_interrupted<T>(work: impl FnOnce() -> Result<T>) -> Result<T> {
-    if INTERRUPTS.load(Ordering::SeqCst) > 0 {
-        bail!("interrupted");
+/// The design search's scene files, one per setting, beside the scene.
+struct DesignFiles<'a>(&'a [PathBuf]);
+
+impl Scenes for DesignFiles<'_> {
+    fn load(&self, k: usize, json: &Value) -> Result<Scene, SearchError> {
+        let text = serde_json::to_string_pretty(json).expect("a JSON value serialises");
+        let boxed = |e| SearchError::Scenes(Box::new(e));
+        files::write_atomic(&self.0[k], text.as_bytes()).map_err(boxed)?;
+        crate::scene::load(&self.0[k]).map_err(|e| SearchError::Scenes(Box::new(e)))
     }
-    work()
+}
+
+/// The search's phases as progress bars, one at a time.
+#[derive(Default)]
+struct Bars(std::sync::Mutex<Option<indicatif::ProgressBar>>);
+
+impl Watch for Bars {
+    fn begin(&self, total: u64, what: &str) {
+        *self.0.lock().expect("no panic holds the bar") = Some(progress::steps(total, what));
+    }
+    fn step(&self) {
+        if let Some(bar) = &*self.0.lock().expect("no panic holds the bar") {
+            bar.inc(1);
+        }
+    }
+    fn end(&self) {
+        if let Some(bar) = self.0.lock().expect("no panic holds the bar").take() {
+            bar.finish_and_clear();
+        }
+    }
 }
 
 /// Share of the target the start guess leaves bare (0 to 1) from which, with a final
@@ -495,348 +495,6 @@ fn too_few_objects(missed: f64, iou: f64, auto: bool) -> Option<String> {
         "the objects leave {:.0} % of the picture bare at the start, and the design reaches IoU {iou:.3}; the picture may need {advice}",
         100.0 * missed
     ))
-}
-
-/// Where a design's trial solve ended.
-#[derive(Clone, Copy, Debug)]
-struct Solved {
-    /// IoU at `t` of the solution.
-    iou: f64,
-    /// No contact before `t`.
-    clear: bool,
-    /// The stages it ran, of all: fewer for a design the race left behind.
-    stages: (usize, usize),
-}
-
-impl Solved {
-    /// Whether its solve ran every stage (it won its way to the race's last rung).
-    fn finished(&self) -> bool {
-        self.stages.0 >= self.stages.1
-    }
-}
-
-/// One design of the picture under one ceiling and order, made contact-free.
-struct Variant {
-    plan: Plan,
-    setting: Setting,
-    /// Moves [`separate`] took.
-    moves: usize,
-    /// The start guess's IoU and whether it flies without contact before `t`.
-    iou: f64,
-    clear: bool,
-    /// The trial solve's end ([`ChooseBy::Solve`]).
-    solved: Option<Solved>,
-}
-
-impl Variant {
-    /// The solved picture first (contact-free first, then the higher IoU), then the
-    /// start guess's (the same order).
-    fn better_than(&self, other: &Variant) -> bool {
-        rank(self.solved, self.clear, self.iou) > rank(other.solved, other.clear, other.iou)
-    }
-}
-
-/// The order of [`Variant::better_than`] as a tuple: a design with a trial solve
-/// ranks by it (one that ran every stage before one the race left behind), and by its
-/// start guess after that.
-fn rank(solved: Option<Solved>, clear: bool, iou: f64) -> (bool, bool, f64, bool, f64) {
-    match solved {
-        Some(s) => (s.finished(), s.clear, s.iou, clear, iou),
-        None => (true, clear, iou, clear, iou),
-    }
-}
-
-/// What became of one design's trial solve, for [`trials_line`].
-#[derive(Clone, Copy, Debug)]
-enum Trial {
-    /// Solved (`None` when the choice is by the start guess).
-    Solved(Option<Solved>),
-    /// The same scene as a design before it, not solved again.
-    Same,
-    /// The design failed (its error is reported if no design succeeds).
-    Failed,
-}
-
-/// "trial solves under ceilings 0.8 / 0.7 / ... of the light's height: IoU a / b / ...
-/// (largest object first), e / same / ... (best fit first)[; placed anew: ...]; kept the
-/// design under c, best fit first[, placed anew]": what the choice was made on (a trial
-/// that ended with a contact says so; "same" is a design that an earlier one made too).
-/// `seen` is in the order of the settings: rounds, then [`design::ORDERS`], then
-/// [`design::CEILINGS`]; the second round only when it ran.
-fn trials_line(seen: &[Trial], kept: Setting) -> String {
-    let ceilings: Vec<String> = design::CEILINGS.iter().map(|c| format!("{c}")).collect();
-    let per_round: Vec<String> = seen
-        .chunks(design::CEILINGS.len() * design::ORDERS.len())
-        .map(|round| {
-            let per_order: Vec<String> = design::ORDERS
-                .iter()
-                .zip(round.chunks(design::CEILINGS.len()))
-                .map(|(order, trials)| {
-                    let ious: Vec<String> = trials
-                        .iter()
-                        .map(|s| match s {
-                            Trial::Solved(Some(s)) => format!(
-                                "{:.4}{}{}",
-                                s.iou,
-                                if s.clear { "" } else { " (contact)" },
-                                if s.finished() {
-                                    String::new()
-                                } else {
-                                    format!(
-                                        " (raced out after {} of {} stages)",
-                                        s.stages.0, s.stages.1
-                                    )
-                                }
-                            ),
-                            Trial::Solved(None) | Trial::Failed => "-".to_string(),
-                            Trial::Same => "same".to_string(),
-                        })
-                        .collect();
-                    format!("{} ({})", ious.join(" / "), order.label())
-                })
-                .collect();
-            per_order.join(", ")
-        })
-        .collect();
-    format!(
-        "trial solves under ceilings {} of the light's height: IoU {}; kept the design under {}, {}{}",
-        ceilings.join(" / "),
-        per_round.join("; placed anew: "),
-        kept.ceiling,
-        kept.order.label(),
-        if kept.replace { ", placed anew" } else { "" }
-    )
-}
-
-/// What one design is made under.
-#[derive(Clone, Copy, Debug)]
-struct Setting {
-    order: Order,
-    /// The highest flight at `t`, as a share of the light's height ([`design::CEILINGS`]).
-    ceiling: f64,
-    /// Every object placed anew after the exchanges ([`design::cover::Cover::replace`]).
-    replace: bool,
-}
-
-/// What a round of designs needs: the picture, the objects and the settings, with one
-/// scratch file per setting.
-struct Round<'a> {
-    picture: &'a Picture,
-    geometry: &'a Geometry,
-    request: &'a Request,
-    settings: &'a [Setting],
-    files: &'a [PathBuf],
-    name: &'a str,
-    seed: u64,
-    /// Whether each design is trial-solved ([`ChooseBy::Solve`]).
-    trial: bool,
-}
-
-impl Round<'_> {
-    /// Design under the settings `ks` (in parallel, each made contact-free), append
-    /// them to `designed`, and to `same_as` the earlier design each repeats (one that
-    /// another order or round made too); with `trial`, solve each that repeats none.
-    fn run(
-        &self,
-        ks: std::ops::Range<usize>,
-        designed: &mut Vec<Result<Variant>>,
-        same_as: &mut Vec<Option<usize>>,
-    ) {
-        let (name, seed) = (self.name, self.seed);
-        let replace = ks.clone().any(|k| self.settings[k].replace);
-        let bar = progress::steps(
-            ks.len() as u64,
-            &format!(
-                "{name}: designing under {} ceilings and {} orders{}",
-                design::CEILINGS.len(),
-                design::ORDERS.len(),
-                if replace { ", objects placed anew" } else { "" }
-            ),
-        );
-        let made: Vec<Result<Variant>> = ks
-            .clone()
-            .into_par_iter()
-            .map(|k| {
-                let geometry = Geometry {
-                    ceiling: self.settings[k].ceiling,
-                    ..self.geometry.clone()
-                };
-                let variant = unless_interrupted(|| {
-                    design_variant(
-                        self.picture,
-                        geometry,
-                        self.request,
-                        self.settings[k],
-                        &self.files[k],
-                        name,
-                        seed,
-                    )
-                });
-                bar.inc(1);
-                variant
-            })
-            .collect();
-        bar.finish_and_clear();
-        designed.extend(made);
-        let scenes: Vec<Option<String>> = designed
-            .iter()
-            .map(|v| {
-                v.as_ref()
-                    .ok()
-                    .map(|v| v.plan.scene_json(name, SCRATCH_TARGET, seed).to_string())
-            })
-            .collect();
-        for k in ks.clone() {
-            same_as.push((0..k).find(|&j| scenes[k].is_some() && scenes[j] == scenes[k]));
-        }
-        if !self.trial {
-            return;
-        }
-        let todo: Vec<usize> = ks
-            .filter(|&k| designed[k].is_ok() && same_as[k].is_none())
-            .collect();
-        let loaded: Vec<(usize, Result<Problem>)> = todo
-            .par_iter()
-            .map(|&k| {
-                let v = designed[k].as_ref().expect("a design to solve");
-                let p = unless_interrupted(|| trial_problem(&v.plan, &self.files[k], name, seed));
-                (k, p)
-            })
-            .collect();
-        let mut entrants = Vec::new();
-        for (k, p) in loaded {
-            match p {
-                Ok(p) => entrants.push((k, p)),
-                Err(e) => designed[k] = Err(e),
-            }
-        }
-        // A solve begun stops at once on Ctrl-C: its solver watches the same counter.
-        for (k, s) in race(entrants, name) {
-            designed[k].as_mut().expect("a raced design").solved = Some(s);
-        }
-    }
-}
-
-/// Design under `geometry`'s ceiling, write the scene to `file` (in the scene's folder),
-/// make its start guess contact-free and evaluate it.
-fn design_variant(
-    picture: &Picture,
-    geometry: Geometry,
-    request: &Request,
-    setting: Setting,
-    file: &Path,
-    name: &str,
-    seed: u64,
-) -> Result<Variant> {
-    let mut plan = design::design(picture, geometry, request, setting.order, setting.replace)?;
-    let json = plan.scene_json(name, SCRATCH_TARGET, seed);
-    files::write_atomic(file, serde_json::to_string_pretty(&json)?.as_bytes())?;
-    let mut problem = Problem::new(load::scene(file)?);
-    let n = plan.objects.len();
-    let sep = separate::separate(&mut plan, &mut problem, 4 * n + 10);
-    let params = separate::apply(&plan, &mut problem);
-    let mut ws = problem.workspace();
-    let start = problem.evaluate(&params, &Weights::default(), &mut ws);
-    Ok(Variant {
-        plan,
-        setting,
-        moves: sep.moves,
-        iou: start.iou,
-        clear: start.outcome.n_contacts == 0,
-        solved: None,
-    })
-}
-
-/// The design as `bsa solve` will solve the scene written from it: the same file (so
-/// the same start, strategy and seed), loaded afresh.
-fn trial_problem(plan: &Plan, file: &Path, name: &str, seed: u64) -> Result<Problem> {
-    let json = plan.scene_json(name, SCRATCH_TARGET, seed);
-    files::write_atomic(file, serde_json::to_string_pretty(&json)?.as_bytes())?;
-    Ok(Problem::new(load::scene(file)?))
-}
-
-/// The share of its stages each rung of the race solves a design to: every design
-/// runs the first quarter, the better half of them the next quarter, the better half
-/// of those the rest (successive halving: half the samples of solving each to its end).
-const RUNGS: [f64; 3] = [0.25, 0.5, 1.0];
-
-/// Race the designs `entrants` (each with its index): each rung of [`RUNGS`] solves
-/// every design left to its share of the stages, resuming where the last rung left it,
-/// and keeps the better half (contact-free first, then the higher IoU) for the next.
-/// The solves leave out the last stage's trades and polish ([`Schedule::TRIAL`]: they
-/// compare designs, not rescues or refinements) and run on one thread each, the
-/// designs side by side (a solve's result does not depend on its thread count).
-/// Returns where each design's solve ended.
-fn race(mut entrants: Vec<(usize, Problem)>, name: &str) -> Vec<(usize, Solved)> {
-    let mut ended = Vec::new();
-    let mut reached: Vec<Option<Solution>> = entrants.iter().map(|_| None).collect();
-    for (r, share) in RUNGS.into_iter().enumerate() {
-        let bar = progress::steps(
-            entrants.len() as u64,
-            &format!(
-                "{name}: racing {} designs ({} of the stages)",
-                entrants.len(),
-                share
-            ),
-        );
-        let solved: Vec<Solution> = entrants
-            .par_iter()
-            .zip(reached.par_iter_mut())
-            .map(|((_, problem), from)| {
-                let stages = problem.scene.stages.len();
-                let options = SolveOptions {
-                    threads: Some(1),
-                    schedule: Schedule::TRIAL,
-                    resume: from.take(),
-                    until_stage: Some(((share * stages as f64).ceil() as usize).clamp(1, stages)),
-                    ..SolveOptions::default()
-                };
-                let (s, _) = solver::solve(problem, &options, &mut Silent, &INTERRUPTS);
-                bar.inc(1);
-                s
-            })
-            .collect();
-        bar.finish_and_clear();
-        let mut order: Vec<usize> = (0..entrants.len()).collect();
-        let key = |s: &Solution| (s.n_contacts == 0, s.iou);
-        order.sort_by(|&a, &b| {
-            key(&solved[b])
-                .partial_cmp(&key(&solved[a]))
-                .expect("IoUs are numbers")
-        });
-        let keep = if r + 1 == RUNGS.len() {
-            order.len()
-        } else {
-            order.len().div_ceil(2)
-        };
-        let mut next = Vec::new();
-        let mut next_reached = Vec::new();
-        let mut slots: Vec<Option<(usize, Problem)>> = entrants.into_iter().map(Some).collect();
-        for (place, &j) in order.iter().enumerate() {
-            let (k, problem) = slots[j].take().expect("each design once");
-            let s = &solved[j];
-            let finished = s.stages_completed >= s.stages_total;
-            if place < keep && !finished {
-                next.push((k, problem));
-                next_reached.push(Some(s.clone()));
-            } else {
-                ended.push((
-                    k,
-                    Solved {
-                        iou: s.iou,
-                        clear: s.n_contacts == 0,
-                        stages: (s.stages_completed, s.stages_total),
-                    },
-                ));
-            }
-        }
-        entrants = next;
-        reached = next_reached;
-        if entrants.is_empty() || INTERRUPTS.load(Ordering::SeqCst) > 0 {
-            break;
-        }
-    }
-    ended
 }
 
 /// An error of the first scene, which is a scratch file the user never wrote, told in

@@ -46,6 +46,7 @@ pub use spin::spin_reaching;
 use crate::energy::{Term, Weights, DIVERGED_ENERGY};
 use crate::evaluate::{Evaluation, Held, Problem, Workspace};
 use crate::geometry::shape::Shape;
+use crate::scene::Scene;
 use crate::shadow::mask::Mask;
 use crate::sim::flight::FreeFlight;
 
@@ -208,6 +209,15 @@ struct Search<'a> {
 }
 
 impl Search<'_> {
+    /// `offer` as a trade the caller may search further.
+    fn trade(&self, offer: &Offer) -> Trade {
+        Trade {
+            launch: offer.launch.clone(),
+            bodies: offer.bodies.clone(),
+            free: self.free(&offer.eval),
+        }
+    }
+
     /// The energy without the contact term: the picture and the scene's pulls.
     fn free(&self, e: &Evaluation) -> f64 {
         e.total - self.weights.get(Term::Contact) * e.raw[Term::Contact as usize]
@@ -294,17 +304,11 @@ pub fn improve(
         blocks,
         meshes,
     } = Bodies::of(scene, vary);
-    // The groups that trade places: the blocks, and the meshes where few enough.
-    let shape = |i: usize| &scene.occluders[i].shape;
-    let trades: Vec<&[usize]> = [&blocks[..], &meshes[..]]
-        .into_iter()
-        .filter(|group| {
-            options.trades
-                && group.iter().any(|&i| shape(i) != shape(group[0]))
-                && (group.len() * group.len().saturating_sub(1) <= MAX_MESH_TRADES
-                    || fits_pose(shape(group[0])))
-        })
-        .collect();
+    let trades = if options.trades {
+        trade_groups(scene, [&blocks, &meshes])
+    } else {
+        Vec::new()
+    };
     if movable.is_empty() || (options.trades && trades.is_empty()) {
         return report;
     }
@@ -317,7 +321,6 @@ pub fn improve(
         promising: None,
     };
     let mut candidate = params.to_vec();
-    let mut chosen = params.to_vec();
     let mut flight = FreeFlight::default();
     let mut exchanges: Vec<Exchange> = Vec::new();
     let mut trade_offers: Vec<Trade> = Vec::new();
@@ -352,8 +355,6 @@ pub fn improve(
             exchanges_wanted,
             trades: &trades,
         };
-        let mut best_rank = rank(&current);
-        let mut found = None;
         // Every move of the round, evaluated; the best few are then polished.
         let mut out = Offers::new(&mut search, ws, &mut candidate, &mut flight);
         for m in MOVES {
@@ -368,28 +369,17 @@ pub fn improve(
         exchanges = offered;
         trade_offers = offers[mesh_trades]
             .iter()
-            .map(|o| Trade {
-                launch: o.launch.clone(),
-                bodies: o.bodies.clone(),
-                free: search.free(&o.eval),
-            })
+            .map(|o| search.trade(o))
             .collect();
         // Polish the moves that made the best pictures (a move that made a poor one
         // seldom becomes the best by a change of depth), then take the best-ranked.
         offers.sort_by(|a, b| search.free(&a.eval).total_cmp(&search.free(&b.eval)));
         let mut scratch = Offers::new(&mut search, ws, &mut candidate, &mut flight);
         polish_best(&mut offers, held, &vary, options, &mut scratch);
-        for offer in &offers {
-            let r = rank(&offer.eval);
-            if r < best_rank {
-                best_rank = r;
-                chosen.copy_from_slice(&offer.launch);
-                found = Some(offer.eval);
-            }
-        }
-        match found {
-            Some(e) => {
-                params.copy_from_slice(&chosen);
+        match best_offer(&offers, rank, rank(&current)) {
+            Some(offer) => {
+                let e = offer.eval;
+                params.copy_from_slice(&offer.launch);
                 *best = e;
                 report.accepted += 1;
                 // Exchanges and trades of the launch before this move are stale.
@@ -401,18 +391,50 @@ pub fn improve(
     }
     // Leave the workspace holding the kept launch's flight and shadow.
     *best = problem.evaluate_held(held, params, weights, ws);
-    report.samples = search.samples;
     let kept = search.free(best);
     exchanges.sort_by(|a, b| a.free.total_cmp(&b.free));
-    report.exchanges = exchanges;
     trade_offers.sort_by(|a, b| a.free.total_cmp(&b.free));
-    report.trades = trade_offers;
-    report.kept_free = kept;
-    report.promising = search
-        .promising
-        .filter(|(energy, _)| *energy < kept)
-        .map(|(_, launch)| launch);
-    report
+    MoveReport {
+        samples: search.samples,
+        exchanges,
+        trades: trade_offers,
+        kept_free: kept,
+        promising: search
+            .promising
+            .filter(|(energy, _)| *energy < kept)
+            .map(|(_, launch)| launch),
+        ..report
+    }
+}
+
+/// The groups of bodies that trade places: the blocks, and the meshes where few
+/// enough, each group only where its shapes differ.
+fn trade_groups<'a>(scene: &Scene, groups: [&'a [usize]; 2]) -> Vec<&'a [usize]> {
+    let shape = |i: usize| &scene.occluders[i].shape;
+    groups
+        .into_iter()
+        .filter(|group| {
+            group.iter().any(|&i| shape(i) != shape(group[0]))
+                && (group.len() * group.len().saturating_sub(1) <= MAX_MESH_TRADES
+                    || fits_pose(shape(group[0])))
+        })
+        .collect()
+}
+
+/// The first of the offers that ranks best, if it ranks better than `kept`.
+fn best_offer<'a>(
+    offers: &'a [Offer],
+    rank: &dyn Fn(&Evaluation) -> f64,
+    kept: f64,
+) -> Option<&'a Offer> {
+    let mut best = (kept, None);
+    for offer in offers {
+        let r = rank(&offer.eval);
+        if r < best.0 {
+            best = (r, Some(offer));
+        }
+    }
+    best.1
 }
 
 /// The launched bodies of `vary`, and the blocks and meshes among them.

@@ -1,0 +1,488 @@
+//! Composing a scene from a picture and a box of objects: the design search of
+//! `bsa new` ([`Search::run`]), the picture designed under every
+//! [`Setting`] (each of [`CEILINGS`] in each of [`ORDERS`]), each design made
+//! contact-free ([`separate`]); the designs that differ from those before them then
+//! race ([`race`]) and the best ([`Variant::better_than`]) is kept ([`Found`]). When no
+//! design's solve reaches [`REPLACE_BELOW`], a second round designs every setting again
+//! with its objects placed anew ([`crate::design::cover::Cover::replace`]) and races those.
+//!
+//! A start guess's IoU says little of where its solve ends: on 27 held-out pictures the
+//! design with the best start was the best solved one for 12. So the designs are
+//! solved as `bsa solve` will solve them (the scene's seed and strategy,
+//! [`Schedule::TRIAL`]) in a race of successive halving ([`RUNGS`]).
+//!
+//! Each design's scene is written and loaded by the caller ([`Scenes`]: mesh paths are
+//! relative to the scene's folder), so that the trial solves the very scene `bsa new`
+//! writes and this module touches no file. The caller watches through [`Watch`] and
+//! stops the search with the interrupt counter the solver watches too.
+
+use std::ops::Range;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use rayon::prelude::*;
+use serde_json::Value;
+
+use crate::design::launch::{Geometry, Plan};
+use crate::design::picture::Picture;
+use crate::design::{self, separate, DesignError, Order, Request, CEILINGS, ORDERS, REPLACE_BELOW};
+use crate::energy::Weights;
+use crate::evaluate::Problem;
+use crate::optimize::solver::{self, Schedule, Silent, SolveOptions};
+use crate::output::solution::Solution;
+use crate::scene::Scene;
+
+/// Why a design of the search failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SearchError {
+    #[error(transparent)]
+    Design(#[from] DesignError),
+    /// The caller could not write or load a design's scene ([`Scenes`]).
+    #[error(transparent)]
+    Scenes(Box<dyn std::error::Error + Send + Sync>),
+    /// The interrupt counter was raised before the design began.
+    #[error("interrupted")]
+    Interrupted,
+}
+
+/// What one design is made under.
+#[derive(Clone, Copy, Debug)]
+pub struct Setting {
+    pub order: Order,
+    /// The highest flight at `t`, as a share of the light's height ([`CEILINGS`]).
+    pub ceiling: f64,
+    /// Every object placed anew after the exchanges
+    /// ([`crate::design::cover::Cover::replace`]).
+    pub replace: bool,
+}
+
+/// Every setting of the search, orders outermost: first as greedy, exchanged and
+/// polished; then, in the second round, with every object placed anew too.
+pub fn settings() -> Vec<Setting> {
+    [false, true]
+        .into_iter()
+        .flat_map(|replace| {
+            ORDERS.iter().flat_map(move |&order| {
+                CEILINGS.iter().map(move |&ceiling| Setting {
+                    order,
+                    ceiling,
+                    replace,
+                })
+            })
+        })
+        .collect()
+}
+
+/// The settings of the first round.
+const FIRST_ROUND: usize = ORDERS.len() * CEILINGS.len();
+
+/// Where a design's trial solve ended.
+#[derive(Clone, Copy, Debug)]
+pub struct Solved {
+    /// IoU at `t` of the solution.
+    pub iou: f64,
+    /// No contact before `t`.
+    pub clear: bool,
+    /// The stages it ran, of all: fewer for a design the race left behind.
+    pub stages: (usize, usize),
+}
+
+impl Solved {
+    /// Whether its solve ran every stage (it won its way to the race's last rung).
+    pub fn finished(&self) -> bool {
+        self.stages.0 >= self.stages.1
+    }
+}
+
+/// One design of the picture under one setting, made contact-free.
+pub struct Variant {
+    pub plan: Plan,
+    pub setting: Setting,
+    /// Moves [`separate`] took.
+    pub moves: usize,
+    /// The start guess's IoU and whether it flies without contact before `t`.
+    pub iou: f64,
+    pub clear: bool,
+    /// The trial solve's end (none when the search does not solve).
+    pub solved: Option<Solved>,
+}
+
+impl Variant {
+    /// The solved picture first (contact-free first, then the higher IoU), then the
+    /// start guess's (the same order).
+    pub fn better_than(&self, other: &Variant) -> bool {
+        rank(self.solved, self.clear, self.iou) > rank(other.solved, other.clear, other.iou)
+    }
+}
+
+/// The order of [`Variant::better_than`] as a tuple: a design with a trial solve
+/// ranks by it (one that ran every stage before one the race left behind), and by its
+/// start guess after that.
+fn rank(solved: Option<Solved>, clear: bool, iou: f64) -> (bool, bool, f64, bool, f64) {
+    match solved {
+        Some(s) => (s.finished(), s.clear, s.iou, clear, iou),
+        None => (true, clear, iou, clear, iou),
+    }
+}
+
+/// What became of one design's trial solve, for [`Found::trials_line`].
+#[derive(Clone, Copy, Debug)]
+pub enum Trial {
+    /// Solved (`None` when the search does not solve).
+    Solved(Option<Solved>),
+    /// The same scene as a design before it, not solved again.
+    Same,
+    /// The design failed (its error is reported if no design succeeds).
+    Failed,
+}
+
+/// How the caller watches the search: phases of counted steps (the CLI draws a
+/// progress bar for each). Steps are counted from worker threads.
+pub trait Watch: Sync {
+    /// A phase of `total` steps begins, described by `what`.
+    fn begin(&self, total: u64, what: &str);
+    /// One step of the phase is done.
+    fn step(&self);
+    /// The phase ended.
+    fn end(&self);
+}
+
+/// Where the designs' scenes are written and loaded from: one scene file per setting
+/// of [`settings`], in the scene's folder (its mesh paths are relative to it).
+pub trait Scenes: Sync {
+    /// Write the scene file `json` of setting `k` and load it back.
+    fn load(&self, k: usize, json: &Value) -> Result<Scene, SearchError>;
+}
+
+/// A search's inputs: the picture, the objects, where the designs' scenes go and what
+/// the scene is called.
+pub struct Search<'a> {
+    pub picture: &'a Picture,
+    pub geometry: &'a Geometry,
+    pub request: &'a Request,
+    pub scenes: &'a dyn Scenes,
+    pub name: &'a str,
+    /// The target's file name as the scene files name it.
+    pub target: &'a str,
+    pub seed: u64,
+    /// Whether each design is trial-solved (else they rank by their start guesses).
+    pub trial: bool,
+}
+
+/// What the search found: the best design, the first error (when no design was made)
+/// and every setting's trial, in the order of [`settings`].
+pub struct Found {
+    pub best: Option<Variant>,
+    pub first_error: Option<SearchError>,
+    pub trials: Vec<Trial>,
+}
+
+impl Search<'_> {
+    /// Design under every setting of the first round and race the designs; when no
+    /// trial reaches [`REPLACE_BELOW`], the second round too; keep the best of all.
+    /// After an interrupt the designs not begun fail with [`SearchError::Interrupted`].
+    pub fn run(&self, watch: &dyn Watch, interrupts: &AtomicUsize) -> Found {
+        let settings = settings();
+        let mut designed = Vec::new();
+        let mut same_as = Vec::new();
+        let round = |ks, designed: &mut _, same_as: &mut _| {
+            self.round(&settings, ks, designed, same_as, watch, interrupts)
+        };
+        round(0..FIRST_ROUND, &mut designed, &mut same_as);
+        let best_trial = designed
+            .iter()
+            .filter_map(|v| v.as_ref().ok()?.solved)
+            .filter(|s| s.clear && s.finished())
+            .map(|s| s.iou)
+            .fold(f64::NEG_INFINITY, f64::max);
+        if self.trial && best_trial < REPLACE_BELOW && interrupts.load(Ordering::SeqCst) == 0 {
+            round(FIRST_ROUND..settings.len(), &mut designed, &mut same_as);
+        }
+        let mut found = Found {
+            best: None,
+            first_error: None,
+            trials: Vec::new(),
+        };
+        for (v, same) in designed.into_iter().zip(same_as) {
+            match v {
+                Ok(v) => {
+                    found.trials.push(match same {
+                        Some(_) => Trial::Same,
+                        None => Trial::Solved(v.solved),
+                    });
+                    if found.best.as_ref().is_none_or(|b| v.better_than(b)) {
+                        found.best = Some(v);
+                    }
+                }
+                Err(e) => {
+                    found.trials.push(Trial::Failed);
+                    found.first_error.get_or_insert(e);
+                }
+            }
+        }
+        found
+    }
+
+    /// Design under the settings `ks` (in parallel, each made contact-free), append
+    /// them to `designed`, and to `same_as` the earlier design each repeats (one that
+    /// another order or round made too); with `trial`, race those that repeat none.
+    fn round(
+        &self,
+        settings: &[Setting],
+        ks: Range<usize>,
+        designed: &mut Vec<Result<Variant, SearchError>>,
+        same_as: &mut Vec<Option<usize>>,
+        watch: &dyn Watch,
+        interrupts: &AtomicUsize,
+    ) {
+        let replace = ks.clone().any(|k| settings[k].replace);
+        watch.begin(
+            ks.len() as u64,
+            &format!(
+                "{}: designing under {} ceilings and {} orders{}",
+                self.name,
+                CEILINGS.len(),
+                ORDERS.len(),
+                if replace { ", objects placed anew" } else { "" }
+            ),
+        );
+        let made: Vec<Result<Variant, SearchError>> = ks
+            .clone()
+            .into_par_iter()
+            .map(|k| {
+                let variant = unless_interrupted(interrupts, || self.design(settings[k], k));
+                watch.step();
+                variant
+            })
+            .collect();
+        watch.end();
+        designed.extend(made);
+        let scenes: Vec<Option<String>> = designed
+            .iter()
+            .map(|v| {
+                v.as_ref()
+                    .ok()
+                    .map(|v| self.scene_json(&v.plan).to_string())
+            })
+            .collect();
+        for k in ks.clone() {
+            same_as.push((0..k).find(|&j| scenes[k].is_some() && scenes[j] == scenes[k]));
+        }
+        if !self.trial {
+            return;
+        }
+        let todo: Vec<usize> = ks
+            .filter(|&k| designed[k].is_ok() && same_as[k].is_none())
+            .collect();
+        let loaded: Vec<(usize, Result<Problem, SearchError>)> = todo
+            .par_iter()
+            .map(|&k| {
+                let v = designed[k].as_ref().expect("a design to solve");
+                let p = unless_interrupted(interrupts, || self.problem(&v.plan, k));
+                (k, p)
+            })
+            .collect();
+        let mut entrants = Vec::new();
+        for (k, p) in loaded {
+            match p {
+                Ok(p) => entrants.push((k, p)),
+                Err(e) => designed[k] = Err(e),
+            }
+        }
+        // A solve begun stops at once on an interrupt: its solver watches the counter.
+        for (k, s) in race(entrants, self.name, watch, interrupts) {
+            designed[k].as_mut().expect("a raced design").solved = Some(s);
+        }
+    }
+
+    /// The scene file's JSON of `plan`.
+    fn scene_json(&self, plan: &Plan) -> Value {
+        plan.scene_json(self.name, self.target, self.seed)
+    }
+
+    /// The scene of `plan` as setting `k`'s scene file loads it.
+    fn problem(&self, plan: &Plan, k: usize) -> Result<Problem, SearchError> {
+        Ok(Problem::new(self.scenes.load(k, &self.scene_json(plan))?))
+    }
+
+    /// Design under `setting` (the `k`-th), make its start guess contact-free and
+    /// evaluate it.
+    fn design(&self, setting: Setting, k: usize) -> Result<Variant, SearchError> {
+        let geometry = Geometry {
+            ceiling: setting.ceiling,
+            ..self.geometry.clone()
+        };
+        let mut plan = design::design(
+            self.picture,
+            geometry,
+            self.request,
+            setting.order,
+            setting.replace,
+        )?;
+        let mut problem = self.problem(&plan, k)?;
+        let n = plan.objects.len();
+        let sep = separate::separate(&mut plan, &mut problem, 4 * n + 10);
+        let params = separate::apply(&plan, &mut problem);
+        let mut ws = problem.workspace();
+        let start = problem.evaluate(&params, &Weights::default(), &mut ws);
+        Ok(Variant {
+            plan,
+            setting,
+            moves: sep.moves,
+            iou: start.iou,
+            clear: start.outcome.n_contacts == 0,
+            solved: None,
+        })
+    }
+}
+
+/// `work()`, unless the interrupt counter was raised: after it nothing is written, so
+/// the designs and trial solves not yet begun are skipped.
+fn unless_interrupted<T>(
+    interrupts: &AtomicUsize,
+    work: impl FnOnce() -> Result<T, SearchError>,
+) -> Result<T, SearchError> {
+    if interrupts.load(Ordering::SeqCst) > 0 {
+        return Err(SearchError::Interrupted);
+    }
+    work()
+}
+
+/// The share of its stages each rung of the race solves a design to: every design
+/// runs the first quarter, the better half of them the next quarter, the better half
+/// of those the rest (successive halving: half the samples of solving each to its end).
+pub const RUNGS: [f64; 3] = [0.25, 0.5, 1.0];
+
+/// Race the designs `entrants` (each with its index): each rung of [`RUNGS`] solves
+/// every design left to its share of the stages, resuming where the last rung left it,
+/// and keeps the better half (contact-free first, then the higher IoU) for the next.
+/// The solves leave out the last stage's trades and polish ([`Schedule::TRIAL`]: they
+/// compare designs, not rescues or refinements) and run on one thread each, the
+/// designs side by side (a solve's result does not depend on its thread count).
+/// Returns where each design's solve ended.
+pub fn race(
+    mut entrants: Vec<(usize, Problem)>,
+    name: &str,
+    watch: &dyn Watch,
+    interrupts: &AtomicUsize,
+) -> Vec<(usize, Solved)> {
+    let mut ended = Vec::new();
+    let mut reached: Vec<Option<Solution>> = entrants.iter().map(|_| None).collect();
+    for (r, share) in RUNGS.into_iter().enumerate() {
+        watch.begin(
+            entrants.len() as u64,
+            &format!(
+                "{name}: racing {} designs ({} of the stages)",
+                entrants.len(),
+                share
+            ),
+        );
+        let solved: Vec<Solution> = entrants
+            .par_iter()
+            .zip(reached.par_iter_mut())
+            .map(|((_, problem), from)| {
+                let stages = problem.scene.stages.len();
+                let options = SolveOptions {
+                    threads: Some(1),
+                    schedule: Schedule::TRIAL,
+                    resume: from.take(),
+                    until_stage: Some(((share * stages as f64).ceil() as usize).clamp(1, stages)),
+                    ..SolveOptions::default()
+                };
+                let (s, _) = solver::solve(problem, &options, &mut Silent, interrupts);
+                watch.step();
+                s
+            })
+            .collect();
+        watch.end();
+        let mut order: Vec<usize> = (0..entrants.len()).collect();
+        let key = |s: &Solution| (s.n_contacts == 0, s.iou);
+        order.sort_by(|&a, &b| {
+            key(&solved[b])
+                .partial_cmp(&key(&solved[a]))
+                .expect("IoUs are numbers")
+        });
+        let keep = if r + 1 == RUNGS.len() {
+            order.len()
+        } else {
+            order.len().div_ceil(2)
+        };
+        let mut next = Vec::new();
+        let mut next_reached = Vec::new();
+        let mut slots: Vec<Option<(usize, Problem)>> = entrants.into_iter().map(Some).collect();
+        for (place, &j) in order.iter().enumerate() {
+            let (k, problem) = slots[j].take().expect("each design once");
+            let s = &solved[j];
+            if place < keep && s.stages_completed < s.stages_total {
+                next.push((k, problem));
+                next_reached.push(Some(s.clone()));
+            } else {
+                ended.push((
+                    k,
+                    Solved {
+                        iou: s.iou,
+                        clear: s.n_contacts == 0,
+                        stages: (s.stages_completed, s.stages_total),
+                    },
+                ));
+            }
+        }
+        entrants = next;
+        reached = next_reached;
+        if entrants.is_empty() || interrupts.load(Ordering::SeqCst) > 0 {
+            break;
+        }
+    }
+    ended
+}
+
+impl Found {
+    /// "trial solves under ceilings 0.8 / 0.7 / ... of the light's height: IoU a / b /
+    /// ... (largest object first), e / same / ... (best fit first)[; placed anew:
+    /// ...]; kept the design under c, best fit first[, placed anew]": what the choice
+    /// was made on (a trial that ended with a contact says so; "same" is a design that
+    /// an earlier one made too). The second round only when it ran.
+    pub fn trials_line(&self, kept: Setting) -> String {
+        let ceilings: Vec<String> = CEILINGS.iter().map(|c| format!("{c}")).collect();
+        let per_round: Vec<String> = self
+            .trials
+            .chunks(FIRST_ROUND)
+            .map(|round| {
+                let per_order: Vec<String> = ORDERS
+                    .iter()
+                    .zip(round.chunks(CEILINGS.len()))
+                    .map(|(order, trials)| {
+                        let ious: Vec<String> = trials.iter().map(trial_text).collect();
+                        format!("{} ({})", ious.join(" / "), order.label())
+                    })
+                    .collect();
+                per_order.join(", ")
+            })
+            .collect();
+        format!(
+            "trial solves under ceilings {} of the light's height: IoU {}; kept the design under {}, {}{}",
+            ceilings.join(" / "),
+            per_round.join("; placed anew: "),
+            kept.ceiling,
+            kept.order.label(),
+            if kept.replace { ", placed anew" } else { "" }
+        )
+    }
+}
+
+/// One trial as [`Found::trials_line`] writes it.
+fn trial_text(trial: &Trial) -> String {
+    match trial {
+        Trial::Solved(Some(s)) => format!(
+            "{:.4}{}{}",
+            s.iou,
+            if s.clear { "" } else { " (contact)" },
+            if s.finished() {
+                String::new()
+            } else {
+                format!(" (raced out after {} of {} stages)", s.stages.0, s.stages.1)
+            }
+        ),
+        Trial::Solved(None) | Trial::Failed => "-".to_string(),
+        Trial::Same => "same".to_string(),
+    }
+}
