@@ -7,7 +7,9 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 
-use crate::budget::{self, plots, short, BudgetError, BudgetOptions, Tolerances};
+use crate::budget::{
+    self, plots, short, BudgetError, BudgetOptions, BudgetReport, BudgetRun, Tolerances,
+};
 use crate::evaluate::Problem;
 use crate::output::files;
 use crate::sim::drag::{DragConfig, DragError};
@@ -152,9 +154,36 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let run = budget::run(&problem, &solution.parameters(), &opts.budget, &bars)?;
     let elapsed = start.elapsed().as_secs_f64();
     let r = &run.report;
+    write_files(&dir, &problem, &run, opts.budget.threads, elapsed)?;
+    print_summary(r);
+    // The solve's report page shows the budget too, so it is rewritten with it.
+    let report = crate::output::report::write_report(&dir, &solution)?;
+    println!(
+        "wrote {}/{{budget.md, budget.json, launch_drag.csv, budget_hist.png, budget_hist.svg{}, report.html}} in {elapsed:.2} s",
+        dir.display(),
+        if r.search.is_some() {
+            ", budget_tolerances.png, budget_tolerances.svg"
+        } else {
+            ""
+        }
+    );
+    println!("report: {}", report.display());
+    Ok(())
+}
 
+/// Write the budget's files into `dir`: `launch_drag.csv`, `budget.json`, `budget.md`
+/// (saying it took `elapsed` seconds on `threads`) and the plots, removing a tolerance
+/// plot of an earlier run that this one has no search for.
+fn write_files(
+    dir: &Path,
+    problem: &Problem,
+    run: &BudgetRun,
+    threads: Option<usize>,
+    elapsed: f64,
+) -> Result<()> {
+    let r = &run.report;
     // launch_drag.csv: the launch table of the compensated launch, its pose at t with drag.
-    let mut rows = crate::output::trajectory::launch_rows(&problem, &run.compensated);
+    let mut rows = crate::output::trajectory::launch_rows(problem, &run.compensated);
     for (row, com) in rows.iter_mut().zip(&run.compensated_com) {
         row.com_at_t_x_m = com.x;
         row.com_at_t_y_m = com.y;
@@ -168,16 +197,16 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let mut md = r.markdown();
     md.push_str(&format!(
         "\nMade by `bsa budget` in {elapsed:.2} s on {} threads.\n",
-        opts.budget.threads.unwrap_or_else(|| {
+        threads.unwrap_or_else(|| {
             std::thread::available_parallelism()
                 .map(|n| n.get())
                 .unwrap_or(1)
         })
     ));
     files::write_atomic(&dir.join("budget.md"), md.as_bytes())?;
-    files::save_figure(&dir, "budget_hist", &plots::histogram(r)?)?;
+    files::save_figure(dir, "budget_hist", &plots::histogram(r)?)?;
     match plots::tolerances(r) {
-        Some(figure) => files::save_figure(&dir, "budget_tolerances", &figure?)?,
+        Some(figure) => files::save_figure(dir, "budget_tolerances", &figure?)?,
         // No search this time: a plot left by an earlier run would not match budget.json.
         None => {
             for ext in ["png", "svg"] {
@@ -189,7 +218,12 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             }
         }
     }
+    Ok(())
+}
 
+/// The summary on the terminal: the IoU in vacuum, with drag and compensated, each
+/// launched occluder's drag and compensation, the Monte Carlo and the tolerance search.
+fn print_summary(r: &BudgetReport) {
     println!(
         "{}: IoU at t {:.4} in vacuum, {:.4} with drag, {:.4} with the drag-compensated launch",
         r.scene, r.iou_vacuum, r.iou_drag_uncompensated, r.iou_drag_compensated
@@ -245,17 +279,4 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             se.joint_scale
         );
     }
-    // The solve's report page shows the budget too, so it is rewritten with it.
-    let report = crate::output::report::write_report(&dir, &solution)?;
-    println!(
-        "wrote {}/{{budget.md, budget.json, launch_drag.csv, budget_hist.png, budget_hist.svg{}, report.html}} in {elapsed:.2} s",
-        dir.display(),
-        if r.search.is_some() {
-            ", budget_tolerances.png, budget_tolerances.svg"
-        } else {
-            ""
-        }
-    );
-    println!("report: {}", report.display());
-    Ok(())
 }

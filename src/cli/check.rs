@@ -9,7 +9,7 @@ use crate::energy::{Term, Weights};
 use crate::evaluate::Problem;
 use crate::geometry::shape::Shape;
 use crate::optimize::solver::Schedule;
-use crate::scene::Strategy;
+use crate::scene::{Scene, Strategy};
 
 use super::{load, CheckArgs};
 
@@ -50,6 +50,19 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         s.dt,
         fmt_vec(s.gravity)
     );
+    print_pictures(&s);
+    print_setting(&s);
+    print_occluders(&s);
+    println!("  hints    {}", s.hints.len());
+    print_strategy(&s);
+    println!("  seed     {}", s.seed);
+    print_start(&s);
+    println!("ok");
+    Ok(())
+}
+
+/// The pictures of a scene with several, and the hold window and free positions.
+fn print_pictures(s: &Scene) {
     if s.pictures.len() > 1 {
         println!(
             "  pictures {} (the last is the target and t above):",
@@ -80,6 +93,10 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     if s.positions == crate::scene::LaunchPositions::Free {
         println!("  positions free: launch positions on the table are optimised too");
     }
+}
+
+/// The light, the receiver and the table.
+fn print_setting(s: &Scene) {
     println!("  light    {} m", fmt_vec(s.light));
     let r = &s.receiver;
     println!(
@@ -100,6 +117,10 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         ),
         None => println!("  table    none"),
     }
+}
+
+/// One line per occluder: name, shape, mass, position, launched or not.
+fn print_occluders(s: &Scene) {
     println!("  occluders ({}):", s.occluders.len());
     for o in &s.occluders {
         let shape = match &o.shape {
@@ -120,7 +141,11 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             if o.launched { "launched" } else { "stays put" }
         );
     }
-    println!("  hints    {}", s.hints.len());
+}
+
+/// The strategy, and one line per stage: what it varies, its CMA-ES settings, its
+/// weights.
+fn print_strategy(s: &Scene) {
     match &s.strategy {
         Strategy::Scheduled => println!("  strategy scheduled, {} stages", s.stages.len()),
         Strategy::Sequential { order } => println!(
@@ -149,7 +174,11 @@ pub(super) fn run(opts: &Options) -> Result<()> {
             w.join(" ")
         );
     }
-    println!("  seed     {}", s.seed);
+}
+
+/// How the start guess looks: its IoU and first contact (the instants' IoUs with
+/// several), and what a solve of the scene costs.
+fn print_start(s: &Scene) {
     // The start guess is where every stage's search begins: say how it looks, and name a
     // contact in it, since a start that collides is a slow start.
     let problem = Problem::new(s.clone());
@@ -173,6 +202,4 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         "  cost     {}",
         super::progress::cost_line(&problem, &Schedule::DEFAULT, None)
     );
-    println!("ok");
-    Ok(())
 }

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 
 use crate::energy::{Term, Weights};
+use crate::evaluate::{Evaluation, FrameIou, Problem};
 use crate::output::files;
 use crate::scene::Scene;
 
@@ -103,79 +104,142 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         Some(reps) => problem.profile(&s.parameters(), reps, &mut ws),
         None => Vec::new(),
     };
+    let terms = Terms {
+        stage: k,
+        rows,
+        total,
+        evaluation: e,
+        first_contact,
+        outside,
+        frame_ious,
+        timings,
+    };
     if opts.json {
-        let terms: serde_json::Map<String, serde_json::Value> = rows
-            .iter()
-            .map(|(t, raw, w, wt)| {
-                (
-                    t.key().to_string(),
-                    serde_json::json!({"raw": raw, "weight": w, "weighted": wt}),
-                )
-            })
-            .collect();
-        let v = serde_json::json!({
-            "scene": scene.name,
-            "stage": k,
-            "terms": terms,
-            "total": total,
-            "iou": e.iou,
-            "t_sim": e.outcome.t_sim,
-            "n_contacts": e.outcome.n_contacts,
-            "first_contact": first_contact.as_ref().map(|(a, b)| [a, b]),
-            "shadows_outside_image": outside,
-            "time_per_phase_us": timings.iter().map(|(k, v)| (k.clone(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
-        });
-        let mut v = v;
-        if !frame_ious.is_empty() {
-            v["frames"] = frame_ious
-                .iter()
-                .map(|f| serde_json::json!({"t_s": f.t, "picture": f.picture + 1, "iou": f.iou}))
-                .collect();
-        }
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        print_json(scene, &terms)?;
     } else {
-        println!(
-            "scene `{}`, weights of stage {} `{}`",
-            scene.name,
-            k,
-            scene.stages[k - 1].name
-        );
-        println!(
-            "{:<24} {:>14} {:>10} {:>14}",
-            "term", "raw", "weight", "weighted"
-        );
-        for (t, raw, w, wt) in &rows {
-            println!(
-                "{:<24} {:>14.6} {:>10} {:>14.6}",
-                t.display_name(),
-                raw,
-                w,
-                wt
-            );
-        }
-        println!("{:<24} {:>14} {:>10} {:>14.6}", "total", "", "", total);
-        println!(
-            "IoU at t {:.5}; t_sim {:.5} s; contacts {}",
-            e.iou, e.outcome.t_sim, e.outcome.n_contacts
-        );
-        if let Some((a, b)) = &first_contact {
-            println!("first contact: `{a}` with `{b}`");
-        }
-        super::frames::print(&problem, &frame_ious);
-        if outside.is_empty() {
-            println!(
-                "every occluder's shadow lies in the image ({} occluders)",
-                scene.occluders.len()
-            );
-        } else {
-            println!("shadows leaving the image: {}", outside.join(", "));
-        }
-        if !timings.is_empty() {
-            println!("time per sample phase (one core, microseconds):");
-            for (k, v) in &timings {
-                println!("  {k:<26} {v:>10.2}");
-            }
-        }
+        print_table(&problem, &terms);
     }
     Ok(())
+}
+
+/// What `bsa eval` found of a solution, for [`print_json`] and [`print_table`].
+struct Terms {
+    /// The 1-based stage whose weights the terms are weighted by.
+    stage: usize,
+    /// Every term: raw, its weight, weighted.
+    rows: Vec<(Term, f64, f64, f64)>,
+    /// The weighted terms' sum.
+    total: f64,
+    /// The solution's evaluation with every weight 1.
+    evaluation: Evaluation,
+    /// The names of the first contact's bodies (`table` for the table).
+    first_contact: Option<(String, String)>,
+    /// The occluders whose shadows leave the image.
+    outside: Vec<String>,
+    /// The IoU of each instant (empty for a single instant).
+    frame_ious: Vec<FrameIou>,
+    /// The time of each phase of one sample (`--profile`; else empty).
+    timings: Vec<(String, f64)>,
+}
+
+/// The terms as one JSON object (`--json`).
+fn print_json(scene: &Scene, terms: &Terms) -> Result<()> {
+    let Terms {
+        stage: k,
+        rows,
+        total,
+        evaluation: e,
+        first_contact,
+        outside,
+        frame_ious,
+        timings,
+    } = terms;
+    let terms: serde_json::Map<String, serde_json::Value> = rows
+        .iter()
+        .map(|(t, raw, w, wt)| {
+            (
+                t.key().to_string(),
+                serde_json::json!({"raw": raw, "weight": w, "weighted": wt}),
+            )
+        })
+        .collect();
+    let v = serde_json::json!({
+        "scene": scene.name,
+        "stage": k,
+        "terms": terms,
+        "total": total,
+        "iou": e.iou,
+        "t_sim": e.outcome.t_sim,
+        "n_contacts": e.outcome.n_contacts,
+        "first_contact": first_contact.as_ref().map(|(a, b)| [a, b]),
+        "shadows_outside_image": outside,
+        "time_per_phase_us": timings.iter().map(|(k, v)| (k.clone(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
+    });
+    let mut v = v;
+    if !frame_ious.is_empty() {
+        v["frames"] = frame_ious
+            .iter()
+            .map(|f| serde_json::json!({"t_s": f.t, "picture": f.picture + 1, "iou": f.iou}))
+            .collect();
+    }
+    println!("{}", serde_json::to_string_pretty(&v)?);
+    Ok(())
+}
+
+/// The terms as a table, then the IoU, the contacts, the instants, the shadows leaving
+/// the image and the phases' times.
+fn print_table(problem: &Problem, terms: &Terms) {
+    let scene = &problem.scene;
+    let Terms {
+        stage: k,
+        rows,
+        total,
+        evaluation: e,
+        first_contact,
+        outside,
+        frame_ious,
+        timings,
+    } = terms;
+    println!(
+        "scene `{}`, weights of stage {} `{}`",
+        scene.name,
+        k,
+        scene.stages[k - 1].name
+    );
+    println!(
+        "{:<24} {:>14} {:>10} {:>14}",
+        "term", "raw", "weight", "weighted"
+    );
+    for (t, raw, w, wt) in rows {
+        println!(
+            "{:<24} {:>14.6} {:>10} {:>14.6}",
+            t.display_name(),
+            raw,
+            w,
+            wt
+        );
+    }
+    println!("{:<24} {:>14} {:>10} {:>14.6}", "total", "", "", total);
+    println!(
+        "IoU at t {:.5}; t_sim {:.5} s; contacts {}",
+        e.iou, e.outcome.t_sim, e.outcome.n_contacts
+    );
+    if let Some((a, b)) = first_contact {
+        println!("first contact: `{a}` with `{b}`");
+    }
+    super::frames::print(problem, frame_ious);
+    if outside.is_empty() {
+        println!(
+            "every occluder's shadow lies in the image ({} occluders)",
+            scene.occluders.len()
+        );
+    } else {
+        println!("shadows leaving the image: {}", outside.join(", "));
+    }
+    if !timings.is_empty() {
+        println!("time per sample phase (one core, microseconds):");
+        for (k, v) in timings {
+            println!("  {k:<26} {v:>10.2}");
+        }
+    }
 }

@@ -12,8 +12,8 @@ use crate::energy::Weights;
 use crate::evaluate::{FrameIou, Problem, Robust};
 use crate::optimize::solver::{self, Schedule, SolveOptions};
 use crate::output::files;
-use crate::output::solution::{self, Solution};
-use crate::scene::LaunchPositions;
+use crate::output::solution::{self, SampleRecord, Solution};
+use crate::scene::{LaunchPositions, Scene};
 use crate::sim::drag::DragConfig;
 
 use super::progress::SolveProgress;
@@ -273,68 +273,12 @@ fn solve_into(
 ) -> Result<Solution> {
     let scene = &problem.scene;
     let out = out.to_path_buf();
-    let mut prior = Vec::new();
-    let resume_from = if opts.resume {
-        let file = out.join("solution.json");
-        let s = files::read_solution(&file).context(NotResumed(file.clone()))?;
-        solution::check_resumable(scene, &s).context(NotResumed(file.clone()))?;
-        // A resumed solve goes on as it was started: a different seed, or air or launch
-        // errors for some stages only, would silently mix two solves in one record.
-        let started = |what: String| {
-            anyhow::anyhow!(
-                "it was started {what}, and --resume goes on as it was started; pass the same options, or solve afresh (--force)"
-            )
-            .context(NotResumed(file.clone()))
-        };
-        if let Some(seed) = opts.seed.filter(|&x| x != s.seed) {
-            return Err(started(format!("with seed {}, not --seed {seed}", s.seed)));
-        }
-        if opts.air != s.air.is_some() {
-            let how = if opts.air {
-                "in vacuum, not --air"
-            } else {
-                "with --air"
-            };
-            return Err(started(how.to_string()));
-        }
-        if opts.robust.is_some() != s.robust.is_some() {
-            let how = if opts.robust.is_some() {
-                "without launch errors, not --robust"
-            } else {
-                "with --robust"
-            };
-            return Err(started(how.to_string()));
-        }
-        if s.stages_completed >= s.stages_total {
-            eprintln!(
-                "{}: all {} stages are done already; nothing to resume",
-                file.display(),
-                s.stages_total
-            );
-            return Ok(s);
-        }
-        let conv = out.join("convergence.csv");
-        if conv.exists() {
-            prior = files::read_convergence(&conv, s.stages_completed)?;
-        }
-        eprintln!(
-            "resuming after stage {}/{}",
-            s.stages_completed, s.stages_total
-        );
-        Some(s)
-    } else {
-        None
+    let (resume_from, prior) = match start(opts, scene, &out)? {
+        Start::Fresh => (None, Vec::new()),
+        Start::Resume { from, prior } => (Some(from), prior),
+        Start::Done(s) => return Ok(s),
     };
-    // With ctrlc's "termination" feature this handles SIGTERM (and SIGHUP) like Ctrl-C.
-    ctrlc::set_handler(|| {
-        let n = INTERRUPTS.fetch_add(1, Ordering::SeqCst) + 1;
-        if n == 1 {
-            eprintln!("\ninterrupt: ending this stage (press Ctrl-C again to stop and save the best so far)");
-        } else {
-            eprintln!("\ninterrupt: stopping and saving the best so far");
-        }
-    })
-    .context("cannot install the Ctrl-C handler")?;
+    install_interrupt_handler()?;
     let mut observer = SolveProgress::new(out.clone(), scene, &prior, opts.quiet)?;
     // A resumed solve keeps the seed it was started with.
     let seed = resume_from.as_ref().map(|s| s.seed).or(opts.seed);
@@ -390,15 +334,115 @@ fn solve_into(
         write_pictures_and_exports(&out, problem, &solution)
     });
     plotted?;
+    let written = pictures?;
+    clock.lap("convergence plot beside shadow, overlay, preview and exports");
+    let report = crate::output::report::write_report(&out, &solution)?;
+    clock.lap("report page");
+    print_summary(scene, problem, &solution, &out, &written);
+    println!("report: {}", report.display());
+    if opts.report {
+        print_report(&solution, &clock);
+    }
+    Ok(solution)
+}
+
+/// Where a solve starts: afresh, after the stages a saved solution completed (with the
+/// convergence records of those stages), or nowhere, every stage of the saved one done.
+enum Start {
+    Fresh,
+    Resume {
+        from: Solution,
+        prior: Vec<SampleRecord>,
+    },
+    Done(Solution),
+}
+
+/// Where the solve starts: with `--resume`, the `solution.json` in `out`, checked to
+/// belong to `scene` and to have been started with the same options.
+fn start(opts: &Options, scene: &Scene, out: &Path) -> Result<Start> {
+    if !opts.resume {
+        return Ok(Start::Fresh);
+    }
+    let file = out.join("solution.json");
+    let s = files::read_solution(&file).context(NotResumed(file.clone()))?;
+    solution::check_resumable(scene, &s).context(NotResumed(file.clone()))?;
+    // A resumed solve goes on as it was started: a different seed, or air or launch
+    // errors for some stages only, would silently mix two solves in one record.
+    let started = |what: String| {
+        anyhow::anyhow!(
+            "it was started {what}, and --resume goes on as it was started; pass the same options, or solve afresh (--force)"
+        )
+        .context(NotResumed(file.clone()))
+    };
+    if let Some(seed) = opts.seed.filter(|&x| x != s.seed) {
+        return Err(started(format!("with seed {}, not --seed {seed}", s.seed)));
+    }
+    if opts.air != s.air.is_some() {
+        let how = if opts.air {
+            "in vacuum, not --air"
+        } else {
+            "with --air"
+        };
+        return Err(started(how.to_string()));
+    }
+    if opts.robust.is_some() != s.robust.is_some() {
+        let how = if opts.robust.is_some() {
+            "without launch errors, not --robust"
+        } else {
+            "with --robust"
+        };
+        return Err(started(how.to_string()));
+    }
+    if s.stages_completed >= s.stages_total {
+        eprintln!(
+            "{}: all {} stages are done already; nothing to resume",
+            file.display(),
+            s.stages_total
+        );
+        return Ok(Start::Done(s));
+    }
+    let mut prior = Vec::new();
+    let conv = out.join("convergence.csv");
+    if conv.exists() {
+        prior = files::read_convergence(&conv, s.stages_completed)?;
+    }
+    eprintln!(
+        "resuming after stage {}/{}",
+        s.stages_completed, s.stages_total
+    );
+    Ok(Start::Resume { from: s, prior })
+}
+
+/// Count Ctrl-C presses in [`INTERRUPTS`], saying what each one does. With ctrlc's
+/// "termination" feature this handles SIGTERM (and SIGHUP) like Ctrl-C.
+fn install_interrupt_handler() -> Result<()> {
+    ctrlc::set_handler(|| {
+        let n = INTERRUPTS.fetch_add(1, Ordering::SeqCst) + 1;
+        if n == 1 {
+            eprintln!("\ninterrupt: ending this stage (press Ctrl-C again to stop and save the best so far)");
+        } else {
+            eprintln!("\ninterrupt: stopping and saving the best so far");
+        }
+    })
+    .context("cannot install the Ctrl-C handler")
+}
+
+/// The summary of a finished solve: the IoU, the contacts and the work, the attempts,
+/// the files written, shadows beyond the picture, the instants' IoUs and the exports.
+/// `scene` is the scene as loaded, `problem` the one placed at the solution's positions.
+fn print_summary(
+    scene: &Scene,
+    problem: &Problem,
+    solution: &Solution,
+    out: &Path,
+    written: &Written,
+) {
     let Written {
         frame_ious,
         more,
         exported,
         outside,
-    } = pictures?;
-    clock.lap("convergence plot beside shadow, overlay, preview and exports");
-    let report = crate::output::report::write_report(&out, &solution)?;
-    clock.lap("report page");
+    } = written;
     println!(
         "{}: {} {:.4}, {} before {} ({} contacts), {} samples in {} iterations, {:.2} s on {} threads{}",
         scene.name,
@@ -452,13 +496,8 @@ fn solve_into(
             problem.margin
         );
     }
-    frames::print(problem, &frame_ious);
+    frames::print(problem, frame_ious);
     println!("{exported}");
-    println!("report: {}", report.display());
-    if opts.report {
-        print_report(&solution, &clock);
-    }
-    Ok(solution)
 }
 
 /// The problem that launches from the solution's positions, when they were free

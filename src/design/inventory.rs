@@ -182,6 +182,160 @@ fn positive(x: f64, what: &str) -> Result<f64, Fault> {
     }
 }
 
+/// A field at fault and why: `(field, reason)`.
+type Refusal = (String, String);
+
+/// The [`Refusal`] of `field` for `reason`.
+fn refuse(field: &str, reason: impl ToString) -> Refusal {
+    (field.to_string(), reason.to_string())
+}
+
+/// A number the kind needs: present, positive and at most 1000.
+fn need(v: Option<f64>, field: &str, what: &str) -> Result<f64, Refusal> {
+    let x = v.ok_or_else(|| refuse(field, format!("{what} is missing")))?;
+    positive(x, what).map_err(|r| refuse(field, r))
+}
+
+/// A piece of the built-in chess set, by name.
+fn chess_piece(p: &str) -> Result<String, Refusal> {
+    if chess::obj(p).is_some() {
+        Ok(p.to_string())
+    } else {
+        let names: Vec<&str> = chess::PIECES.iter().map(|p| p.0).collect();
+        Err(refuse(
+            "piece",
+            format!("unknown chess piece `{p}` ({})", names.join(", ")),
+        ))
+    }
+}
+
+impl Spec {
+    /// The density: given (positive, at most 100000 kg/m^3), or the kind's default.
+    fn density(&self) -> Result<f64, Refusal> {
+        match self.density {
+            Some(d) if !(d.is_finite() && d > 0.0 && d <= 1e5) => Err(refuse(
+                "density",
+                format!(
+                    "density must be positive and at most 100000 kg/m^3, got {}",
+                    crate::scene::short(d)
+                ),
+            )),
+            Some(d) => Ok(d),
+            None if self.kind == "chess" => Ok(chess::BOXWOOD),
+            None => Ok(DEFAULT_DENSITY),
+        }
+    }
+
+    /// The count: chosen by the design for an `auto:` item (which may give none), else
+    /// given (at least 1) or 1.
+    fn count(&self) -> Result<Count, Refusal> {
+        if self.auto {
+            if self.count.is_some() {
+                return Err(refuse(
+                    "count",
+                    "an auto: item chooses its own count; drop *N",
+                ));
+            }
+            return Ok(Count::Auto);
+        }
+        match self.count {
+            Some(0) => Err(refuse("count", "count must be at least 1")),
+            Some(n) => Ok(Count::Fixed(n)),
+            None => Ok(Count::Fixed(1)),
+        }
+    }
+
+    /// The scale of a mesh: given (positive, at most 1000), or 1.
+    fn scale(&self) -> Result<f64, Refusal> {
+        match self.scale {
+            Some(s) => positive(s, "scale").map_err(|r| refuse("scale", r)),
+            None => Ok(1.0),
+        }
+    }
+
+    /// The OBJ file of a mesh, checked to be there ([`mesh_file`]).
+    fn mesh(&self, look: Look) -> Result<PathBuf, Refusal> {
+        match &self.obj {
+            Some(p) if !p.as_os_str().is_empty() => {
+                mesh_file(p, self.obj_base.as_deref(), look).map_err(|r| refuse("obj", r))?;
+                Ok(p.clone())
+            }
+            _ => Err(refuse("obj", "mesh needs an OBJ file")),
+        }
+    }
+
+    /// The size of a box (m), every side positive and at most 1000.
+    fn size(&self) -> Result<[f64; 3], Refusal> {
+        let s = self
+            .size
+            .ok_or_else(|| refuse("size", "box size must be XxYxZ in metres"))?;
+        let mut out = [0.0; 3];
+        for (o, x) in out.iter_mut().zip(s) {
+            *o = positive(x, "box size").map_err(|r| refuse("size", r))?;
+        }
+        Ok(out)
+    }
+
+    /// The kind of an `auto:` item.
+    fn auto_kind(&self, scale: f64, look: Look) -> Result<AutoKind, Refusal> {
+        Ok(match self.kind.as_str() {
+            "sphere" => AutoKind::Sphere {
+                radius: match self.radius {
+                    Some(r) => Some(positive(r, "radius").map_err(|e| refuse("radius", e))?),
+                    None => None,
+                },
+            },
+            "box" => AutoKind::Box { size: self.size()? },
+            "mesh" => AutoKind::Mesh {
+                obj: self.mesh(look)?,
+                scale,
+            },
+            "chess" => {
+                if self.piece.is_some() {
+                    return Err(refuse(
+                        "piece",
+                        "auto:chess chooses the pieces too; give no piece",
+                    ));
+                }
+                AutoKind::Chess
+            }
+            other => return Err(refuse("kind", format!("unknown kind `{other}`"))),
+        })
+    }
+
+    /// The objects one of a counted item stands for: one, or the 16 pieces of a side of
+    /// the chess set for `chess` without a piece.
+    fn kinds(&self, scale: f64, look: Look) -> Result<Vec<Kind>, Refusal> {
+        Ok(match self.kind.as_str() {
+            "sphere" => vec![Kind::Sphere {
+                radius: need(self.radius, "radius", "radius")?,
+            }],
+            "box" => vec![Kind::Box { size: self.size()? }],
+            "mesh" => vec![Kind::Mesh {
+                obj: self.mesh(look)?,
+                scale,
+            }],
+            "chess" => match &self.piece {
+                Some(p) => vec![Kind::Chess {
+                    piece: chess_piece(p)?,
+                }],
+                None => chess::PIECES
+                    .iter()
+                    .flat_map(|(p, k)| {
+                        std::iter::repeat_n(
+                            Kind::Chess {
+                                piece: p.to_string(),
+                            },
+                            *k,
+                        )
+                    })
+                    .collect(),
+            },
+            other => return Err(refuse("kind", format!("unknown kind `{other}`"))),
+        })
+    }
+}
+
 /// Add `spec`'s objects to `inv`; `Err((field, reason))` names the field at fault.
 fn add(
     spec: Spec,
@@ -189,154 +343,36 @@ fn add(
     auto_at: &mut Option<usize>,
     index: usize,
     look: Look,
-) -> Result<(), (String, String)> {
-    let bad = |field: &str, reason: String| (field.to_string(), reason);
-    let fault = |field: &str, reason: Fault| (field.to_string(), reason.to_string());
-    let density = match spec.density {
-        Some(d) if !(d.is_finite() && d > 0.0 && d <= 1e5) => {
-            return Err(bad(
-                "density",
-                format!(
-                    "density must be positive and at most 100000 kg/m^3, got {}",
-                    crate::scene::short(d)
-                ),
-            ))
-        }
-        Some(d) => d,
-        None if spec.kind == "chess" => chess::BOXWOOD,
-        None => DEFAULT_DENSITY,
-    };
-    let count = if spec.auto {
-        if spec.count.is_some() {
-            return Err(bad(
-                "count",
-                "an auto: item chooses its own count; drop *N".into(),
-            ));
-        }
-        Count::Auto
-    } else {
-        match spec.count {
-            Some(0) => return Err(bad("count", "count must be at least 1".into())),
-            Some(n) => Count::Fixed(n),
-            None => Count::Fixed(1),
-        }
-    };
-    let need = |v: Option<f64>, field: &str, what: &str| -> Result<f64, (String, String)> {
-        let x = v.ok_or_else(|| bad(field, format!("{what} is missing")))?;
-        positive(x, what).map_err(|r| fault(field, r))
-    };
-    let scale = match spec.scale {
-        Some(s) => positive(s, "scale").map_err(|r| fault("scale", r))?,
-        None => 1.0,
-    };
-    let mesh = || -> Result<PathBuf, (String, String)> {
-        match &spec.obj {
-            Some(p) if !p.as_os_str().is_empty() => {
-                mesh_file(p, spec.obj_base.as_deref(), look).map_err(|r| fault("obj", r))?;
-                Ok(p.clone())
-            }
-            _ => Err(bad("obj", "mesh needs an OBJ file".into())),
-        }
-    };
-    let size = || -> Result<[f64; 3], (String, String)> {
-        let s = spec
-            .size
-            .ok_or_else(|| bad("size", "box size must be XxYxZ in metres".into()))?;
-        let mut out = [0.0; 3];
-        for (o, x) in out.iter_mut().zip(s) {
-            *o = positive(x, "box size").map_err(|r| fault("size", r))?;
-        }
-        Ok(out)
-    };
-    let piece = |p: &str| -> Result<String, (String, String)> {
-        if chess::obj(p).is_some() {
-            Ok(p.to_string())
-        } else {
-            let names: Vec<&str> = chess::PIECES.iter().map(|p| p.0).collect();
-            Err(bad(
-                "piece",
-                format!("unknown chess piece `{p}` ({})", names.join(", ")),
-            ))
-        }
-    };
-    if count == Count::Auto {
-        if let Some(first) = *auto_at {
-            return Err(bad(
-                "auto",
-                format!(
-                    "{}",
+) -> Result<(), Refusal> {
+    let density = spec.density()?;
+    let count = spec.count()?;
+    let scale = spec.scale()?;
+    let n = match count {
+        Count::Fixed(n) => n,
+        Count::Auto => {
+            if let Some(first) = *auto_at {
+                return Err(refuse(
+                    "auto",
                     InventoryError::TwoAutos {
                         first,
-                        second: index
-                    }
-                ),
-            ));
-        }
-        *auto_at = Some(index);
-        let kind = match spec.kind.as_str() {
-            "sphere" => AutoKind::Sphere {
-                radius: match spec.radius {
-                    Some(r) => Some(positive(r, "radius").map_err(|e| fault("radius", e))?),
-                    None => None,
-                },
-            },
-            "box" => AutoKind::Box { size: size()? },
-            "mesh" => AutoKind::Mesh {
-                obj: mesh()?,
-                scale,
-            },
-            "chess" => {
-                if spec.piece.is_some() {
-                    return Err(bad(
-                        "piece",
-                        "auto:chess chooses the pieces too; give no piece".into(),
-                    ));
-                }
-                AutoKind::Chess
+                        second: index,
+                    },
+                ));
             }
-            other => return Err(bad("kind", format!("unknown kind `{other}`"))),
-        };
-        inv.auto = Some(Auto { kind, density });
-        return Ok(());
-    }
-    let Count::Fixed(n) = count else {
-        unreachable!()
+            *auto_at = Some(index);
+            let kind = spec.auto_kind(scale, look)?;
+            inv.auto = Some(Auto { kind, density });
+            return Ok(());
+        }
     };
-    let kinds: Vec<Kind> = match spec.kind.as_str() {
-        "sphere" => vec![Kind::Sphere {
-            radius: need(spec.radius, "radius", "radius")?,
-        }],
-        "box" => vec![Kind::Box { size: size()? }],
-        "mesh" => vec![Kind::Mesh {
-            obj: mesh()?,
-            scale,
-        }],
-        "chess" => match &spec.piece {
-            Some(p) => vec![Kind::Chess { piece: piece(p)? }],
-            None => chess::PIECES
-                .iter()
-                .flat_map(|(p, k)| {
-                    std::iter::repeat_n(
-                        Kind::Chess {
-                            piece: p.to_string(),
-                        },
-                        *k,
-                    )
-                })
-                .collect(),
-        },
-        other => return Err(bad("kind", format!("unknown kind `{other}`"))),
-    };
+    let kinds = spec.kinds(scale, look)?;
     // Saturating: a JSON count near 2^64 must not wrap round to a small total.
     let total = inv
         .items
         .len()
         .saturating_add(n.saturating_mul(kinds.len()));
     if total > MAX_OBJECTS {
-        return Err(bad(
-            "count",
-            format!("{}", InventoryError::TooMany { count: total }),
-        ));
+        return Err(refuse("count", InventoryError::TooMany { count: total }));
     }
     for _ in 0..n {
         inv.items.extend(kinds.iter().map(|k| Item {
@@ -492,11 +528,35 @@ pub fn parse(list: &str, look: Look) -> Result<Inventory, InventoryError> {
 /// fields of their kind. Mesh paths are relative to `base` (the file's folder); `look`
 /// tells what one names.
 pub fn parse_json(text: &str, base: &Path, look: Look) -> Result<Inventory, InventoryError> {
-    let json = |field: String, reason: String| InventoryError::Json { field, reason };
     let v: Value = serde_json::from_str(text)
         .map_err(|e| json("objects".into(), format!("not valid JSON: {e}")))?;
-    let list = match &v {
-        Value::Array(a) => a.clone(),
+    let list = json_entries(&v)?;
+    let mut inv = Inventory {
+        items: Vec::new(),
+        auto: None,
+    };
+    let mut auto_at = None;
+    for (i, e) in list.iter().enumerate() {
+        let spec = json_spec(i, e, base)?;
+        let at = |f: &str| format!("objects[{i}].{f}");
+        add(spec, &mut inv, &mut auto_at, i + 1, look).map_err(|(f, r)| json(at(&f), r))?;
+    }
+    if inv.items.is_empty() && inv.auto.is_none() {
+        return Err(InventoryError::Empty);
+    }
+    Ok(inv)
+}
+
+/// The [`InventoryError::Json`] of `field` for `reason`.
+fn json(field: String, reason: String) -> InventoryError {
+    InventoryError::Json { field, reason }
+}
+
+/// The entries of a JSON object list: the array, or the array of `{"objects": [...]}`
+/// and nothing else.
+fn json_entries(v: &Value) -> Result<Vec<Value>, InventoryError> {
+    match v {
+        Value::Array(a) => Ok(a.clone()),
         Value::Object(o) => {
             // As in an entry, a key the list does not know is refused rather than
             // ignored: it is a misspelling or a setting that would have no effect.
@@ -508,119 +568,103 @@ pub fn parse_json(text: &str, base: &Path, look: Look) -> Result<Inventory, Inve
                 ));
             }
             match o.get("objects") {
-                Some(Value::Array(a)) => a.clone(),
-                _ => {
-                    return Err(json(
-                        "objects".into(),
-                        "expected an array of objects, or {\"objects\": [...]}".into(),
-                    ))
-                }
+                Some(Value::Array(a)) => Ok(a.clone()),
+                _ => Err(json(
+                    "objects".into(),
+                    "expected an array of objects, or {\"objects\": [...]}".into(),
+                )),
             }
         }
-        _ => {
+        _ => Err(json(
+            "objects".into(),
+            "expected an array of objects".into(),
+        )),
+    }
+}
+
+/// Entry `i` of a JSON object list as a [`Spec`], its mesh path joined to `base`; the
+/// error names the entry's field (`objects[i].size`).
+fn json_spec(i: usize, e: &Value, base: &Path) -> Result<Spec, InventoryError> {
+    let at = |f: &str| format!("objects[{i}].{f}");
+    let Value::Object(o) = e else {
+        return Err(json(
+            format!("objects[{i}]"),
+            "expected an object such as {\"kind\": \"sphere\", \"radius\": 0.1}".into(),
+        ));
+    };
+    let num = |f: &str| -> Result<Option<f64>, InventoryError> {
+        match o.get(f) {
+            None => Ok(None),
+            Some(x) => x
+                .as_f64()
+                .map(Some)
+                .ok_or_else(|| json(at(f), format!("expected a number, got {x}"))),
+        }
+    };
+    let text_of = |f: &str| -> Result<Option<String>, InventoryError> {
+        match o.get(f) {
+            None => Ok(None),
+            Some(Value::String(s)) => Ok(Some(s.clone())),
+            Some(x) => Err(json(at(f), format!("expected a string, got {x}"))),
+        }
+    };
+    for key in o.keys() {
+        if ![
+            "kind", "radius", "size", "obj", "scale", "piece", "count", "density",
+        ]
+        .contains(&key.as_str())
+        {
+            return Err(json(at(key), "unknown field".into()));
+        }
+    }
+    let kind = text_of("kind")?
+        .ok_or_else(|| json(at("kind"), "missing (sphere, box, mesh or chess)".into()))?;
+    let size = match o.get("size") {
+        None => None,
+        Some(Value::Array(a)) if a.len() == 3 && a.iter().all(Value::is_number) => {
+            Some([0, 1, 2].map(|k| a[k].as_f64().expect("checked")))
+        }
+        Some(x) => {
             return Err(json(
-                "objects".into(),
-                "expected an array of objects".into(),
+                at("size"),
+                format!("expected [X, Y, Z] in metres, got {x}"),
             ))
         }
     };
-    let mut inv = Inventory {
-        items: Vec::new(),
-        auto: None,
-    };
-    let mut auto_at = None;
-    for (i, e) in list.iter().enumerate() {
-        let at = |f: &str| format!("objects[{i}].{f}");
-        let Value::Object(o) = e else {
-            return Err(json(
-                format!("objects[{i}]"),
-                "expected an object such as {\"kind\": \"sphere\", \"radius\": 0.1}".into(),
-            ));
-        };
-        let num = |f: &str| -> Result<Option<f64>, InventoryError> {
-            match o.get(f) {
-                None => Ok(None),
-                Some(x) => x
-                    .as_f64()
-                    .map(Some)
-                    .ok_or_else(|| json(at(f), format!("expected a number, got {x}"))),
+    let (auto, count) = json_count(o.get("count")).map_err(|r| json(at("count"), r))?;
+    Ok(Spec {
+        kind,
+        radius: num("radius")?,
+        size,
+        obj: text_of("obj")?.map(|p| base.join(p)),
+        obj_base: Some(base.to_path_buf()),
+        scale: num("scale")?,
+        piece: text_of("piece")?,
+        auto,
+        count,
+        density: num("density")?,
+    })
+}
+
+/// An entry's `count`: `(auto, count)` for none, `"auto"` or a whole number; the
+/// reason a value is refused.
+fn json_count(count: Option<&Value>) -> Result<(bool, Option<usize>), String> {
+    match count {
+        None => Ok((false, None)),
+        Some(Value::String(s)) if s == "auto" => Ok((true, None)),
+        Some(x) => match (x.as_u64(), x.as_f64()) {
+            (Some(n), _) => Ok((false, Some(usize::try_from(n).unwrap_or(usize::MAX)))),
+            // A whole number beyond u64 (read as a float) is too large, not
+            // malformed; a negative one is below the least count.
+            (None, Some(f)) if f.fract() == 0.0 && f > 0.0 => Err(format!(
+                "count {f} is more than the {MAX_OBJECTS} objects a list may hold"
+            )),
+            (None, Some(f)) if f.fract() == 0.0 => {
+                Err(format!("count must be at least 1, got {x}"))
             }
-        };
-        let text_of = |f: &str| -> Result<Option<String>, InventoryError> {
-            match o.get(f) {
-                None => Ok(None),
-                Some(Value::String(s)) => Ok(Some(s.clone())),
-                Some(x) => Err(json(at(f), format!("expected a string, got {x}"))),
-            }
-        };
-        for key in o.keys() {
-            if ![
-                "kind", "radius", "size", "obj", "scale", "piece", "count", "density",
-            ]
-            .contains(&key.as_str())
-            {
-                return Err(json(at(key), "unknown field".into()));
-            }
-        }
-        let kind = text_of("kind")?
-            .ok_or_else(|| json(at("kind"), "missing (sphere, box, mesh or chess)".into()))?;
-        let size = match o.get("size") {
-            None => None,
-            Some(Value::Array(a)) if a.len() == 3 && a.iter().all(Value::is_number) => {
-                Some([0, 1, 2].map(|k| a[k].as_f64().expect("checked")))
-            }
-            Some(x) => {
-                return Err(json(
-                    at("size"),
-                    format!("expected [X, Y, Z] in metres, got {x}"),
-                ))
-            }
-        };
-        let (auto, count) = match o.get("count") {
-            None => (false, None),
-            Some(Value::String(s)) if s == "auto" => (true, None),
-            Some(x) => match (x.as_u64(), x.as_f64()) {
-                (Some(n), _) => (false, Some(usize::try_from(n).unwrap_or(usize::MAX))),
-                // A whole number beyond u64 (read as a float) is too large, not
-                // malformed; a negative one is below the least count.
-                (None, Some(f)) if f.fract() == 0.0 && f > 0.0 => {
-                    return Err(json(
-                        at("count"),
-                        format!("count {f} is more than the {MAX_OBJECTS} objects a list may hold"),
-                    ))
-                }
-                (None, Some(f)) if f.fract() == 0.0 => {
-                    return Err(json(
-                        at("count"),
-                        format!("count must be at least 1, got {x}"),
-                    ))
-                }
-                _ => {
-                    return Err(json(
-                        at("count"),
-                        format!("expected a whole number or \"auto\", got {x}"),
-                    ))
-                }
-            },
-        };
-        let spec = Spec {
-            kind,
-            radius: num("radius")?,
-            size,
-            obj: text_of("obj")?.map(|p| base.join(p)),
-            obj_base: Some(base.to_path_buf()),
-            scale: num("scale")?,
-            piece: text_of("piece")?,
-            auto,
-            count,
-            density: num("density")?,
-        };
-        add(spec, &mut inv, &mut auto_at, i + 1, look).map_err(|(f, r)| json(at(&f), r))?;
+            _ => Err(format!("expected a whole number or \"auto\", got {x}")),
+        },
     }
-    if inv.items.is_empty() && inv.auto.is_none() {
-        return Err(InventoryError::Empty);
-    }
-    Ok(inv)
 }
 
 #[cfg(test)]

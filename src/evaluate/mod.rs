@@ -23,6 +23,9 @@
 //!
 //! A scene with several pictures, a hold window, air in the loop, launch errors or free
 //! launch positions scores several shadows per sample: see [`instants`].
+//!
+//! The contact search of steps 2 and 3 is in `contacts`, the shadow of step 4 in
+//! `shadow`.
 
 use glam::{DQuat, DVec3};
 
@@ -31,11 +34,12 @@ use crate::geometry::distance::{table_shape, ContactShape};
 use crate::geometry::shape::Shape;
 use crate::scene::{Launch, Scene};
 use crate::shadow::mask::Mask;
-use crate::shadow::raster::{ClosedMesh, MeshSilhouette, RasterScratch, ShadowCamera};
-use crate::sim::contact::{self, Body, Motion};
+use crate::shadow::raster::{MeshSilhouette, RasterScratch, ShadowCamera};
 use crate::sim::flight::{FlightConfig, FreeFlight};
 
+mod contacts;
 pub mod instants;
+mod shadow;
 pub use instants::{FrameIou, Instant, Physics, Plan, Robust, REFERENCE_DRAW};
 
 pub use crate::scene::MAX_TURN;
@@ -59,9 +63,6 @@ pub const PROFILE_PHASES: [&str; 11] = [
     "contact+reg+hint+barrier",
     "sample (all terms)",
 ];
-
-/// Contacts closer together in time than this (s) are counted as one event's contacts.
-const SIMULTANEOUS: f64 = 1e-6;
 
 /// How far the canvas reaches beyond each edge of the picture, at least, as a fraction
 /// of the picture's longer side. (A quarter cost Mickey's samples 12 %; an eighth, with
@@ -514,242 +515,6 @@ impl Problem {
         ((com - q * o.mass.local_com, q), (v, w))
     }
 
-    /// Occluder `i`'s motion: its flight in `flights` if launched, else its launch pose.
-    fn motion<'a>(&self, i: usize, flights: &'a [FreeFlight]) -> Motion<'a> {
-        let o = &self.scene.occluders[i];
-        if o.launched {
-            Motion::Flying(&flights[i])
-        } else {
-            Motion::Fixed {
-                origin: o.position,
-                orientation: o.orientation,
-                com: o.launch_com(),
-            }
-        }
-    }
-
-    /// Step 2: the first contact before `t`. Every contact is given an order key (table
-    /// contacts by occluder, then pairs in `(i, j)` order) and the first is the least
-    /// (time, key): a plain scan in key order, which is also what makes the held
-    /// occluders' cached contacts combine with the varying ones' to the same answer.
-    /// A pair is only searched up to the best time so far (plus the simultaneity window):
-    /// every contact that can change the outcome is still found, whatever the order.
-    fn first_contact(&self, held: Option<&Held>, ws: &mut Workspace) -> Outcome {
-        let scene = &self.scene;
-        let t = self.plan.horizon;
-        let n = scene.occluders.len();
-        let varies = |i: usize| held.is_none_or(|h| h.varying[i]);
-        let ignored = |i: usize| held.is_some_and(|h| h.ignored[i]);
-        // The first contact of all, and the first that involves a varying body.
-        let mut best = (f64::INFINITY, usize::MAX);
-        let mut own = f64::INFINITY;
-        let mut first = None;
-        // Landings are needed for every body (they decide its pose at t), so they are
-        // searched over the whole flight.
-        for i in 0..n {
-            let c = match held {
-                Some(h) if !h.varying[i] => (h.landing[i], h.table_hit[i]),
-                _ => self.table_contact(i, &ws.flights),
-            };
-            (ws.landing[i], ws.table_hit[i]) = c;
-            if let Some(time) = ws.table_hit[i] {
-                if (time, i) < best {
-                    best = (time, i);
-                    first = Some((i, None));
-                }
-                if varies(i) {
-                    own = own.min(time);
-                }
-            }
-        }
-        ws.pair_hits.clear();
-        if let Some(h) = held {
-            for &(tc, key, i, j) in &h.pair_hits {
-                ws.pair_hits.push(tc);
-                if (tc, key) < best {
-                    best = (tc, key);
-                    first = Some((i, Some(j)));
-                }
-            }
-        }
-        let held_pairs = ws.pair_hits.len();
-        ws.pair_counts.clear();
-        let mut key = n;
-        for i in 0..n {
-            for j in (i + 1)..n {
-                key += 1;
-                if !scene.occluders[i].launched && !scene.occluders[j].launched
-                    || !varies(i) && !varies(j)
-                {
-                    continue;
-                }
-                // Every pair searched here involves a varying body: it is searched up
-                // to the first such contact, which finds the first contact of all too.
-                let horizon = t.min(own + SIMULTANEOUS);
-                let flights_of = |k: usize| match held {
-                    Some(h) if !h.varying[k] => &h.flights[..],
-                    _ => &ws.flights[..],
-                };
-                if let Some(tc) = self.pair_contact(i, flights_of(i), j, flights_of(j), horizon) {
-                    ws.pair_hits.push(tc);
-                    ws.pair_counts.push(!ignored(i) && !ignored(j));
-                    if !ignored(i) && !ignored(j) {
-                        own = own.min(tc);
-                    }
-                    if (tc, key - 1) < best {
-                        best = (tc, key - 1);
-                        first = Some((i, Some(j)));
-                    }
-                }
-            }
-        }
-        let own_contact = if own < t {
-            let cut = own + SIMULTANEOUS;
-            let count = (0..n)
-                .filter(|&i| varies(i) && ws.table_hit[i].is_some_and(|tl| tl <= cut))
-                .count()
-                + ws.pair_hits[held_pairs..]
-                    .iter()
-                    .zip(&ws.pair_counts)
-                    .filter(|&(&tc, &counts)| counts && tc <= cut)
-                    .count();
-            (t - own) * count.max(1) as f64
-        } else {
-            0.0
-        };
-        let best = best.0;
-        if best >= t {
-            return Outcome {
-                t_sim: t,
-                n_contacts: 0,
-                first_contact: None,
-                own_contact,
-            };
-        }
-        let cut = best + SIMULTANEOUS;
-        let count = ws
-            .table_hit
-            .iter()
-            .flatten()
-            .filter(|&&tl| tl <= cut)
-            .count()
-            + ws.pair_hits.iter().filter(|&&tc| tc <= cut).count();
-        Outcome {
-            t_sim: best,
-            n_contacts: (count as u32).max(1),
-            first_contact: first,
-            own_contact,
-        }
-    }
-
-    /// Occluder `i`'s first table contact over the flight to `t`: (its landing, its first
-    /// table contact). Only a real landing stops the body; sinking into the table before
-    /// leaving it (a spinning box tipping a corner in) costs a contact, but the body flies
-    /// on, so its launch speed still shapes its shadow at t.
-    fn table_contact(&self, i: usize, flights: &[FreeFlight]) -> (Option<f64>, Option<f64>) {
-        let scene = &self.scene;
-        let (Some(table), Some(ts)) = (&scene.table, &self.table_shape) else {
-            return (None, None);
-        };
-        if !scene.occluders[i].launched {
-            return (None, None);
-        }
-        let body = Body {
-            motion: self.motion(i, flights),
-            shape: &self.shapes[i],
-            radius: scene.occluders[i].bounding_radius,
-        };
-        let c = contact::table_contact(&body, table, ts, self.plan.horizon);
-        (c.filter(|c| c.landed).map(|c| c.time), c.map(|c| c.time))
-    }
-
-    /// First contact of occluders `i` and `j` (their flights in `fi` and `fj`) up to
-    /// `horizon`.
-    fn pair_contact(
-        &self,
-        i: usize,
-        fi: &[FreeFlight],
-        j: usize,
-        fj: &[FreeFlight],
-        horizon: f64,
-    ) -> Option<f64> {
-        let occ = &self.scene.occluders;
-        let a = Body {
-            motion: self.motion(i, fi),
-            shape: &self.shapes[i],
-            radius: occ[i].bounding_radius,
-        };
-        let b = Body {
-            motion: self.motion(j, fj),
-            shape: &self.shapes[j],
-            radius: occ[j].bounding_radius,
-        };
-        contact::pair_contact_time(&a, &b, horizon)
-    }
-
-    /// Step 4: the shadow of every occluder at its pose in `ws.poses`, into `ws.mask`.
-    pub fn shadow(&self, ws: &mut Workspace) {
-        self.shadow_with(None, None, ws)
-    }
-
-    /// The shadow of the occluders in `which` only (`which[i]`), at the poses in
-    /// `ws.poses`, into `ws.mask`.
-    pub fn shadow_only(&self, which: &[bool], ws: &mut Workspace) {
-        self.shadow_with(None, Some(which), ws)
-    }
-
-    /// The shadow of the occluders `held` holds and of those in `which` (`which[i]`, at
-    /// the poses in `ws.poses`), into `ws.mask`.
-    pub fn shadow_held_and(&self, held: &Held, which: &[bool], ws: &mut Workspace) {
-        self.shadow_with(Some(&held.mask), Some(which), ws)
-    }
-
-    /// [`Problem::shadow`] of the occluders in `which` only, drawn over `start` (a held
-    /// shadow; OR is order-free, so the mask is the same as drawing everything).
-    fn shadow_with(&self, start: Option<&Mask>, which: Option<&[bool]>, ws: &mut Workspace) {
-        let cam = &self.canvas;
-        match start {
-            Some(m) => ws.mask.copy_from(m),
-            None => ws.mask.clear(),
-        }
-        for (i, o) in self.scene.occluders.iter().enumerate() {
-            if !among(which, i) {
-                continue;
-            }
-            let (p, q) = ws.poses[i];
-            match &o.shape {
-                Shape::Sphere { radius } => cam.rasterize_sphere(p, *radius, &mut ws.mask),
-                Shape::Cuboid { half_extents } => {
-                    cam.rasterize_box(p, q, *half_extents, &mut ws.mask, &mut ws.raster)
-                }
-                Shape::Mesh(mesh) if self.silhouettes[i].is_some() => cam.rasterize_mesh(
-                    p,
-                    q,
-                    ClosedMesh {
-                        vertices: &mesh.vertices,
-                        triangles: &mesh.triangles,
-                        silhouette: self.silhouettes[i].as_ref().expect("checked"),
-                    },
-                    &mut ws.world_vertices,
-                    &mut ws.mask,
-                    &mut ws.raster,
-                ),
-                Shape::Mesh(mesh) => {
-                    ws.world_vertices.clear();
-                    ws.world_vertices
-                        .extend(mesh.vertices.iter().map(|v| p + q * *v));
-                    cam.rasterize_triangles(
-                        &ws.world_vertices,
-                        &mesh.triangles,
-                        self.closed[i],
-                        &mut ws.mask,
-                        &mut ws.raster,
-                    );
-                }
-            }
-        }
-    }
-
     fn physics_and_scene_terms(
         &self,
         params: &[f64],
@@ -778,47 +543,6 @@ impl Problem {
             }
         }
         raw[Term::Reg as usize] = reg;
-    }
-
-    /// Whether each occluder's shadow at `t` (poses from the last sample in `ws`) lies
-    /// entirely inside the image. For boxes and meshes, every vertex must project inside
-    /// (the shadow is within the hull of the projected vertices); for spheres, 4,096 points
-    /// spread over the surface (Fibonacci lattice) must, with half a pixel to spare for
-    /// the gaps between them. Geometry at or behind the light plane counts as outside.
-    pub fn shadows_in_image(&self, ws: &Workspace) -> Vec<bool> {
-        let cam = &self.scene.camera;
-        let (w, h) = (cam.width_px as f64, cam.height_px as f64);
-        let inside = |p: DVec3, margin: f64| {
-            cam.project(p).is_some_and(|px| {
-                px.x >= margin && px.y >= margin && px.x <= w - margin && px.y <= h - margin
-            })
-        };
-        self.scene
-            .occluders
-            .iter()
-            .enumerate()
-            .map(|(i, o)| {
-                let (p, q) = ws.poses[i];
-                match &o.shape {
-                    Shape::Sphere { radius } => {
-                        const N: usize = 4096;
-                        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-                        (0..N).all(|k| {
-                            let z = 1.0 - 2.0 * (k as f64 + 0.5) / N as f64;
-                            let r = (1.0 - z * z).sqrt();
-                            let a = golden * k as f64;
-                            inside(p + *radius * DVec3::new(r * a.cos(), r * a.sin(), z), 0.5)
-                        })
-                    }
-                    Shape::Cuboid { half_extents } => {
-                        crate::geometry::shape::box_corners(*half_extents)
-                            .iter()
-                            .all(|c| inside(p + q * *c, 0.0))
-                    }
-                    Shape::Mesh(m) => m.vertices.iter().all(|v| inside(p + q * *v, 0.0)),
-                }
-            })
-            .collect()
     }
 
     /// Full parameter vector from a stage's varying subset.

@@ -1,11 +1,15 @@
 //! The number checks of scene validation: every number finite, and bounded by the
 //! limits of `super` (`MAX_COORDINATE`, `MAX_SPEED`, ...) so that the products the
 //! physics forms cannot overflow and everything downstream may trust the scene.
+//!
+//! They are methods of [`Validator`], which this module takes from `super::validate`;
+//! nothing is taken back: the wording of numbers in their messages, [`short`], is
+//! `super`'s, shared with validation and the rest of the crate.
 
 use glam::DVec3;
 
 use super::validate::Validator;
-use super::{Result, MAX_COORDINATE, MAX_T, MAX_WEIGHT, MIN_T};
+use super::{short, Result, MAX_COORDINATE, MAX_T, MAX_WEIGHT, MIN_T};
 
 impl Validator<'_> {
     pub(super) fn finite(&self, field: &str, x: f64) -> Result<f64> {
@@ -120,15 +124,5 @@ impl Validator<'_> {
             return Err(self.field_err(field, "must be a non-zero vector"));
         }
         Ok(v / len)
-    }
-}
-
-/// A number as people write limits: plain from 1e-4 up to 1e5 (3600, 0.5), in exponent
-/// form beyond (1e6, 1e300, 1e-300), which `{}` would print as three hundred digits.
-pub fn short(x: f64) -> String {
-    if x == 0.0 || (1e-4..1e5).contains(&x.abs()) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
     }
 }

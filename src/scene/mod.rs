@@ -29,6 +29,16 @@ fn unreadable(e: &std::io::Error) -> String {
     }
 }
 
+/// A number as people write limits: plain from 1e-4 up to 1e5 (3600, 0.5), in exponent
+/// form beyond (1e6, 1e300, 1e-300), which `{}` would print as three hundred digits.
+pub fn short(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e5).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// Why a scene could not be loaded. Every variant names the file, and the field when
 /// one is at fault, so that the message alone tells the user what to fix.
 #[derive(Debug, thiserror::Error)]
@@ -109,7 +119,6 @@ mod raw;
 mod start;
 mod validate;
 
-pub use bounds::short;
 pub use launch::Launch;
 pub use raw::at_path;
 use raw::RawScene;
