@@ -235,15 +235,7 @@ pub fn run(
     let b = Budget::new(problem, params, opts.drag)?;
     let scene = &problem.scene;
     let n = scene.occluders.len();
-    let threads = opts.threads.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1)
-    });
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("building a rayon thread pool only fails if threads cannot be spawned");
+    let pool = thread_pool(opts.threads);
     let mut bws = b.workspace();
     let exact = vec![BodyError::default(); n];
 
@@ -253,46 +245,7 @@ pub fn run(
     let (comp, info) = b.compensate();
     let iou_comp = b.iou(&comp, &exact, &mut bws).0;
     let compensated_com: Vec<DVec3> = (0..n).map(|i| b.drag_com(&comp, i, &exact[i])).collect();
-    let occluders: Vec<OccluderReport> = scene
-        .occluders
-        .iter()
-        .enumerate()
-        .map(|(i, o)| {
-            let bd = &b.bodies[i];
-            let drag_com = b.drag_com(params, i, &exact[i]);
-            let q_drag = b.drag_orientation(params, i);
-            let Launch {
-                velocity: v_vac, ..
-            } = Launch::get(params, i);
-            let Launch {
-                velocity: v_comp, ..
-            } = Launch::get(&comp, i);
-            OccluderReport {
-                name: o.name.clone(),
-                shape: shape_name(&o.shape),
-                launched: o.launched,
-                mass_kg: o.mass.mass,
-                cd: bd.cd,
-                reference_area_m2: bd.area,
-                drag_k_per_m: bd.k(),
-                terminal_speed_m_s: bd.terminal_speed(scene.gravity.length()),
-                vacuum_com_at_t_m: b.vacuum_com[i].to_array(),
-                drag_com_at_t_m: drag_com.to_array(),
-                position_error_m: drag_com.distance(b.vacuum_com[i]),
-                orientation_error_rad: q_drag.angle_between(b.vacuum_pose[i].1),
-                vacuum_velocity_m_s: v_vac.to_array(),
-                compensated_velocity_m_s: v_comp.to_array(),
-                speed_change_pct: if v_vac.length() > 0.0 {
-                    100.0 * (v_comp.length() / v_vac.length() - 1.0)
-                } else {
-                    0.0
-                },
-                compensated_com_error_m: compensated_com[i].distance(b.vacuum_com[i]),
-                newton_iterations: info[i].0,
-                lands_before_t_in_vacuum_s: b.landed[i],
-            }
-        })
-        .collect();
+    let occluders = occluder_reports(&b, params, &comp, &compensated_com, &info);
 
     // 3. Monte Carlo at the requested tolerances.
     progress.start("Monte Carlo", opts.samples as u64);
@@ -317,46 +270,7 @@ pub fn run(
     let search = (opts.search_samples > 0 && threshold_unreachable.is_none())
         .then(|| search(&b, &comp, opts, &pool, progress));
 
-    let mut notes = vec![
-        "Drag torque is neglected: the orientation at t is the exact torque-free one, so the orientation error is 0 by construction.".to_string(),
-        "Tolerances are 1-sigma normal errors, independent per body; direction: each of two perpendicular components.".to_string(),
-        "The Monte Carlo flies the compensated launch through air; contacts are not modelled with drag.".to_string(),
-    ];
-    if let crate::evaluate::Physics::Air { .. } = problem.plan.physics {
-        notes.push("The launch was solved with air in the loop (`bsa solve --air`): the \"vacuum\" figures are the solve's own model, with drag, and the compensated launch is the launch itself.".to_string());
-    }
-    if !scene.single_instant() {
-        notes.push(format!(
-            "The scene has several instants (pictures or a hold window): the budget measures the picture at t = {} s only.",
-            scene.t
-        ));
-    }
-    for (o, l) in scene.occluders.iter().zip(&b.landed) {
-        if let Some(tl) = l {
-            notes.push(format!(
-                "`{}` lands on the table at {tl:.3} s in the vacuum solution; the drag model flies it freely to t.",
-                o.name
-            ));
-        }
-    }
-    if let Some(u) = &threshold_unreachable {
-        notes.push(format!(
-            "Threshold unreachable: {}. The tolerance search was skipped.",
-            u.message
-        ));
-    } else if b.vacuum_iou < opts.iou_threshold {
-        notes.push(format!(
-            "The vacuum solution reaches IoU {:.4} < threshold {}, but the drag-compensated launch reaches {:.4}.",
-            b.vacuum_iou,
-            short(opts.iou_threshold),
-            iou_comp
-        ));
-    }
-    if diverged > 0 {
-        notes.push(format!(
-            "{diverged} Monte Carlo samples diverged and count with IoU 0."
-        ));
-    }
+    let notes = notes(&b, opts, threshold_unreachable.as_ref(), iou_comp, diverged);
     let report = BudgetReport {
         scene: scene.name.clone(),
         t_s: scene.t,
@@ -382,6 +296,127 @@ pub fn run(
         compensated_com,
         ious,
     })
+}
+
+/// A pool of `threads` workers (None: one per core).
+fn thread_pool(threads: Option<usize>) -> rayon::ThreadPool {
+    let threads = threads.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("building a rayon thread pool only fails if threads cannot be spawned")
+}
+
+/// The drag figures of every occluder: the vacuum launch `params` flown through air, and
+/// the compensated launch `comp` (its centres of mass at `t` and Newton `info` as
+/// [`Budget::compensate`] gives them).
+fn occluder_reports(
+    b: &Budget,
+    params: &[f64],
+    comp: &[f64],
+    compensated_com: &[DVec3],
+    info: &[(usize, f64)],
+) -> Vec<OccluderReport> {
+    let scene = &b.problem.scene;
+    let exact = BodyError::default();
+    scene
+        .occluders
+        .iter()
+        .enumerate()
+        .map(|(i, o)| {
+            let bd = &b.bodies[i];
+            let drag_com = b.drag_com(params, i, &exact);
+            let q_drag = b.drag_orientation(params, i);
+            let Launch {
+                velocity: v_vac, ..
+            } = Launch::get(params, i);
+            let Launch {
+                velocity: v_comp, ..
+            } = Launch::get(comp, i);
+            OccluderReport {
+                name: o.name.clone(),
+                shape: shape_name(&o.shape),
+                launched: o.launched,
+                mass_kg: o.mass.mass,
+                cd: bd.cd,
+                reference_area_m2: bd.area,
+                drag_k_per_m: bd.k(),
+                terminal_speed_m_s: bd.terminal_speed(scene.gravity.length()),
+                vacuum_com_at_t_m: b.vacuum_com[i].to_array(),
+                drag_com_at_t_m: drag_com.to_array(),
+                position_error_m: drag_com.distance(b.vacuum_com[i]),
+                orientation_error_rad: q_drag.angle_between(b.vacuum_pose[i].1),
+                vacuum_velocity_m_s: v_vac.to_array(),
+                compensated_velocity_m_s: v_comp.to_array(),
+                speed_change_pct: if v_vac.length() > 0.0 {
+                    100.0 * (v_comp.length() / v_vac.length() - 1.0)
+                } else {
+                    0.0
+                },
+                compensated_com_error_m: compensated_com[i].distance(b.vacuum_com[i]),
+                newton_iterations: info[i].0,
+                lands_before_t_in_vacuum_s: b.landed[i],
+            }
+        })
+        .collect()
+}
+
+/// The report's notes: the model's simplifications always, then what applies to this
+/// scene and run (air in the solve, several instants, landings, the threshold,
+/// diverged samples).
+fn notes(
+    b: &Budget,
+    opts: &BudgetOptions,
+    threshold_unreachable: Option<&Unreachable>,
+    iou_comp: f64,
+    diverged: usize,
+) -> Vec<String> {
+    let scene = &b.problem.scene;
+    let mut notes = vec![
+        "Drag torque is neglected: the orientation at t is the exact torque-free one, so the orientation error is 0 by construction.".to_string(),
+        "Tolerances are 1-sigma normal errors, independent per body; direction: each of two perpendicular components.".to_string(),
+        "The Monte Carlo flies the compensated launch through air; contacts are not modelled with drag.".to_string(),
+    ];
+    if let crate::evaluate::Physics::Air { .. } = b.problem.plan.physics {
+        notes.push("The launch was solved with air in the loop (`bsa solve --air`): the \"vacuum\" figures are the solve's own model, with drag, and the compensated launch is the launch itself.".to_string());
+    }
+    if !scene.single_instant() {
+        notes.push(format!(
+            "The scene has several instants (pictures or a hold window): the budget measures the picture at t = {} s only.",
+            scene.t
+        ));
+    }
+    for (o, l) in scene.occluders.iter().zip(&b.landed) {
+        if let Some(tl) = l {
+            notes.push(format!(
+                "`{}` lands on the table at {tl:.3} s in the vacuum solution; the drag model flies it freely to t.",
+                o.name
+            ));
+        }
+    }
+    if let Some(u) = threshold_unreachable {
+        notes.push(format!(
+            "Threshold unreachable: {}. The tolerance search was skipped.",
+            u.message
+        ));
+    } else if b.vacuum_iou < opts.iou_threshold {
+        notes.push(format!(
+            "The vacuum solution reaches IoU {:.4} < threshold {}, but the drag-compensated launch reaches {:.4}.",
+            b.vacuum_iou,
+            short(opts.iou_threshold),
+            iou_comp
+        ));
+    }
+    if diverged > 0 {
+        notes.push(format!(
+            "{diverged} Monte Carlo samples diverged and count with IoU 0."
+        ));
+    }
+    notes
 }
 
 #[cfg(test)]

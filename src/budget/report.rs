@@ -1,6 +1,8 @@
 //! What `budget.json` holds ([`BudgetReport`] and its parts) and its Markdown rendering
 //! (`budget.md`).
 
+use std::fmt::Write;
+
 use super::*;
 
 /// Numbers the user gave (a tolerance, a threshold, an air density) are written as
@@ -204,10 +206,24 @@ pub struct BudgetRun {
 impl BudgetReport {
     /// The report as Markdown (`budget.md`).
     pub fn markdown(&self) -> String {
-        use std::fmt::Write;
         let mut s = String::new();
+        self.md_header(&mut s);
+        self.md_drag(&mut s);
+        self.md_monte_carlo(&mut s);
+        self.md_sensitivity(&mut s);
+        self.md_search(&mut s);
+        if !self.notes.is_empty() {
+            let _ = writeln!(s, "## Notes\n");
+            for n in &self.notes {
+                let _ = writeln!(s, "- {n}");
+            }
+        }
+        s
+    }
+
+    /// The title and the line of the run's settings (air, seed).
+    fn md_header(&self, s: &mut String) {
         let d = &self.drag;
-        let t = &self.tolerances;
         let _ = writeln!(s, "# Error budget: `{}`\n", self.scene);
         let _ = writeln!(
             s,
@@ -221,6 +237,11 @@ impl BudgetReport {
             short(d.max_step),
             self.seed
         );
+    }
+
+    /// The drag section: the table of IoUs in vacuum and in air, then the table of every
+    /// occluder's drag figures.
+    fn md_drag(&self, s: &mut String) {
         let _ = writeln!(s, "## Drag\n");
         let _ = writeln!(
             s,
@@ -258,6 +279,12 @@ impl BudgetReport {
             );
         }
         let _ = writeln!(s, "\nThe compensated launch table is `launch_drag.csv` (same columns as `launch.csv`; the predicted pose at t is the one with drag).\n");
+    }
+
+    /// The Monte Carlo section: the tolerances, the table of IoU statistics and the
+    /// histogram's picture.
+    fn md_monte_carlo(&self, s: &mut String) {
+        let t = &self.tolerances;
         let m = &self.monte_carlo;
         let _ = writeln!(
             s,
@@ -285,6 +312,11 @@ impl BudgetReport {
             m.diverged
         );
         let _ = writeln!(s, "![IoU histogram](budget_hist.png)\n");
+    }
+
+    /// The sensitivity section: the table of IoU lost and shift per unit error, a row per
+    /// occluder.
+    fn md_sensitivity(&self, s: &mut String) {
         let _ = writeln!(
             s,
             "## Sensitivity (one body at a time, central differences)\n"
@@ -307,6 +339,12 @@ impl BudgetReport {
                 r.mm_per_pct_cd
             );
         }
+    }
+
+    /// The tolerance section: why it was not searched, or the table of each error's
+    /// largest size alone, the joint scale and the curves' picture; nothing when the
+    /// search was neither run nor impossible.
+    fn md_search(&self, s: &mut String) {
         if let Some(u) = &self.threshold_unreachable {
             let _ = writeln!(
                 s,
@@ -316,45 +354,39 @@ impl BudgetReport {
                 u.message
             );
         }
-        if let Some(se) = &self.search {
+        let Some(se) = &self.search else {
+            return;
+        };
+        let _ = writeln!(
+            s,
+            "\n## Largest tolerances keeping P(IoU >= {}) >= {} %\n\n{} samples per evaluation (the same draws at every size).\n",
+            short(self.iou_threshold),
+            100.0 * self.probability_target,
+            se.samples_per_evaluation
+        );
+        let _ = writeln!(s, "| error | alone (others exact) |\n|---|---|");
+        for p in &se.single {
             let _ = writeln!(
                 s,
-                "\n## Largest tolerances keeping P(IoU >= {}) >= {} %\n\n{} samples per evaluation (the same draws at every size).\n",
-                short(self.iou_threshold),
-                100.0 * self.probability_target,
-                se.samples_per_evaluation
+                "| {} | {}{:.4} {} |",
+                p.parameter,
+                if p.at_limit { ">= " } else { "" },
+                p.largest,
+                p.unit
             );
-            let _ = writeln!(s, "| error | alone (others exact) |\n|---|---|");
-            for p in &se.single {
-                let _ = writeln!(
-                    s,
-                    "| {} | {}{:.4} {} |",
-                    p.parameter,
-                    if p.at_limit { ">= " } else { "" },
-                    p.largest,
-                    p.unit
-                );
-            }
-            let j = &se.joint_tolerances;
-            let _ = writeln!(
-                s,
-                "\nAll together, the requested tolerances scaled by {}{:.4}: speed {:.4} %, direction {:.4} deg, spin {:.4} %, timing {:.4} ms, Cd {:.4} %.\n",
-                if se.joint_at_limit { ">= " } else { "" },
-                se.joint_scale,
-                j.speed_pct,
-                j.direction_deg,
-                j.spin_pct,
-                j.timing_ms,
-                j.cd_pct
-            );
-            let _ = writeln!(s, "![IoU against each tolerance](budget_tolerances.png)\n");
         }
-        if !self.notes.is_empty() {
-            let _ = writeln!(s, "## Notes\n");
-            for n in &self.notes {
-                let _ = writeln!(s, "- {n}");
-            }
-        }
-        s
+        let j = &se.joint_tolerances;
+        let _ = writeln!(
+            s,
+            "\nAll together, the requested tolerances scaled by {}{:.4}: speed {:.4} %, direction {:.4} deg, spin {:.4} %, timing {:.4} ms, Cd {:.4} %.\n",
+            if se.joint_at_limit { ">= " } else { "" },
+            se.joint_scale,
+            j.speed_pct,
+            j.direction_deg,
+            j.spin_pct,
+            j.timing_ms,
+            j.cd_pct
+        );
+        let _ = writeln!(s, "![IoU against each tolerance](budget_tolerances.png)\n");
     }
 }

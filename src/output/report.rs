@@ -83,6 +83,21 @@ img{max-width:100%;border:1px solid #ddd}pre{background:#f7f7f7;padding:0.8em;ov
 /// The page for `solution` with the pictures found in `dir`.
 pub fn report_html(dir: &Path, s: &Solution) -> Result<String, ExportError> {
     let mut h = String::new();
+    head_html(&mut h, s);
+    pictures_html(&mut h, dir)?;
+    energy_html(&mut h, s);
+    launch_html(&mut h, s);
+    contacts_html(&mut h, s);
+    stages_html(&mut h, s);
+    passes_html(&mut h, s);
+    budget_html(&mut h, dir)?;
+    h.push_str("<p><small>Written by bsa (ballistic-shadow-art).</small></p>\n</body></html>\n");
+    Ok(h)
+}
+
+/// The page's head, its title and the one-paragraph summary of the solve, with a line
+/// on the attempts when there were several.
+fn head_html(h: &mut String, s: &Solution) {
     let _ = write!(
         h,
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
@@ -120,12 +135,20 @@ pub fn report_html(dir: &Path, s: &Solution) -> Result<String, ExportError> {
             esc(&each.join("; "))
         );
     }
+}
+
+/// The [`PICTURES`] of `dir` that exist, each under its title.
+fn pictures_html(h: &mut String, dir: &Path) -> Result<(), ExportError> {
     for (file, title) in PICTURES {
         if let Some(bytes) = read_optional(&dir.join(file))? {
             let _ = writeln!(h, "<h2>{title}</h2>\n{}", img_tag(&bytes, title));
         }
     }
+    Ok(())
+}
 
+/// The table of the energy terms at the solution, raw and weighted, and their total.
+fn energy_html(h: &mut String, s: &Solution) {
     h.push_str(
         "<h2>Energy terms at the solution</h2>\n<table><tr><th>term</th><th>raw</th>\
          <th>weighted (last stage)</th></tr>\n",
@@ -157,7 +180,10 @@ pub fn report_html(dir: &Path, s: &Solution) -> Result<String, ExportError> {
         "<tr><th>total</th><th></th><th>{:.6e}</th></tr></table>",
         s.total_energy
     );
+}
 
+/// The table of every occluder's launch, velocities with their units.
+fn launch_html(h: &mut String, s: &Solution) {
     // Micrometres per second and microradians per second are the precision that
     // matters for a launcher; more digits are the solver's noise.
     h.push_str(
@@ -178,7 +204,12 @@ pub fn report_html(dir: &Path, s: &Solution) -> Result<String, ExportError> {
         }
         h.push_str("</tr>\n");
     }
-    h.push_str("</table>\n<h2>Contacts before t</h2>\n");
+    h.push_str("</table>\n");
+}
+
+/// The contacts before t: none, or how many and when the first one happens.
+fn contacts_html(h: &mut String, s: &Solution) {
+    h.push_str("<h2>Contacts before t</h2>\n");
     if s.n_contacts == 0 {
         let _ = writeln!(
             h,
@@ -193,7 +224,10 @@ pub fn report_html(dir: &Path, s: &Solution) -> Result<String, ExportError> {
             s.n_contacts, s.t_sim, s.t
         );
     }
+}
 
+/// The table of the solver's stages, a row each.
+fn stages_html(h: &mut String, s: &Solution) {
     h.push_str(
         "<h2>Stages</h2>\n<table><tr><th>stage</th><th>iterations</th><th>samples</th>\
          <th>population</th><th>best energy</th><th>IoU</th><th>stop</th>\
@@ -216,26 +250,29 @@ pub fn report_html(dir: &Path, s: &Solution) -> Result<String, ExportError> {
         );
     }
     h.push_str("</table>\n");
-    passes_html(&mut h, s);
+}
 
-    if let Some(md) = read_optional(&dir.join("budget.md"))? {
-        h.push_str("<h2>Error budget</h2>\n");
-        for file in BUDGET_PICTURES {
-            if let Some(bytes) = read_optional(&dir.join(file))? {
-                let _ = writeln!(h, "<p>{}</p>", img_tag(&bytes, file));
-            }
+/// The error budget when `bsa budget` has written `dir/budget.md`: its pictures, then its
+/// Markdown as text; nothing otherwise.
+fn budget_html(h: &mut String, dir: &Path) -> Result<(), ExportError> {
+    let Some(md) = read_optional(&dir.join("budget.md"))? else {
+        return Ok(());
+    };
+    h.push_str("<h2>Error budget</h2>\n");
+    for file in BUDGET_PICTURES {
+        if let Some(bytes) = read_optional(&dir.join(file))? {
+            let _ = writeln!(h, "<p>{}</p>", img_tag(&bytes, file));
         }
-        // The budget's Markdown as written: its tables read as text, and its image
-        // links (shown above) are dropped.
-        let text: String = String::from_utf8_lossy(&md)
-            .lines()
-            .filter(|l| !l.starts_with("!["))
-            .map(|l| format!("{l}\n"))
-            .collect();
-        let _ = writeln!(h, "<pre>{}</pre>", esc(&text));
     }
-    h.push_str("<p><small>Written by bsa (ballistic-shadow-art).</small></p>\n</body></html>\n");
-    Ok(h)
+    // The budget's Markdown as written: its tables read as text, and its image
+    // links (shown above) are dropped.
+    let text: String = String::from_utf8_lossy(&md)
+        .lines()
+        .filter(|l| !l.starts_with("!["))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let _ = writeln!(h, "<pre>{}</pre>", esc(&text));
+    Ok(())
 }
 
 /// The passes of the solver's schedule that ran: a line per kind of pass (how often,

@@ -144,61 +144,8 @@ pub fn simulate(
     world.integration_parameters.num_solver_iterations = cfg.substeps.max(1);
     let h = scene.dt / cfg.substeps.max(1) as f64;
     let half_gh = scene.gravity * (h / 2.0);
-
-    if let Some(table) = &scene.table {
-        let body = RigidBodyBuilder::fixed().translation(table.center.as_vec3());
-        let h = table.half_extents.as_vec3();
-        let collider = ColliderBuilder::cuboid(h.x, h.y, h.z)
-            .restitution(cfg.restitution as f32)
-            .friction(cfg.friction as f32);
-        world.insert(body, collider);
-    }
-    // The receiver is a real surface (a floor or a wall): bodies must not pass through it.
-    let rc = &scene.receiver;
-    let body = RigidBodyBuilder::fixed().translation(rc.center.as_vec3());
-    let collider = ColliderBuilder::new(SharedShape::halfspace(rc.normal.as_vec3()))
-        .restitution(cfg.restitution as f32)
-        .friction(cfg.friction as f32);
-    world.insert(body, collider);
-
-    let mut handles: Vec<RigidBodyHandle> = Vec::with_capacity(start.len());
-    let mut colliders: Vec<ColliderHandle> = Vec::with_capacity(start.len());
-    for (o, s) in scene.occluders.iter().zip(start) {
-        let mp = &o.mass;
-        let mprops = MassProperties::with_principal_inertia_frame(
-            mp.local_com.as_vec3(),
-            mp.mass as f32,
-            mp.principal_inertia.as_vec3(),
-            mp.principal_frame.as_quat(),
-        );
-        let body = RigidBodyBuilder::dynamic()
-            .pose(Pose::from_parts(
-                s.origin.as_vec3(),
-                s.orientation.as_quat(),
-            ))
-            .linvel((s.velocity - half_gh).as_vec3())
-            .angvel(s.angular_velocity.as_vec3())
-            .additional_mass_properties(mprops)
-            .allow_fast_rotation(true)
-            .ccd_enabled(true);
-        let collider = match &o.shape {
-            Shape::Sphere { radius } => ColliderBuilder::ball(*radius as f32),
-            Shape::Cuboid { half_extents } => {
-                let e = half_extents.as_vec3();
-                ColliderBuilder::cuboid(e.x, e.y, e.z)
-            }
-            Shape::Mesh(m) => {
-                let pts: Vec<_> = m.vertices.iter().map(|v| v.as_vec3()).collect();
-                ColliderBuilder::new(mesh_hull(&pts, o.bounding_radius))
-            }
-        }
-        .density(0.0)
-        .restitution(cfg.restitution as f32)
-        .friction(cfg.friction as f32);
-        let (handle, collider) = world.insert(body, collider);
-        handles.push(handle);
-        colliders.push(collider);
-    }
+    insert_surfaces(&mut world, scene, cfg);
+    let (handles, colliders) = insert_bodies(&mut world, scene, start, half_gh, cfg);
     // Bounding radii about the centre of mass (for the rolling resistance's spin-down)
     // and about the body origin (for the point speed of the rest test).
     let com_radius: Vec<f64> = scene.occluders.iter().map(|o| o.bounding_radius).collect();
@@ -251,6 +198,77 @@ pub fn simulate(
         }
     }
     frames
+}
+
+/// Insert the fixed surfaces: the table, if the scene has one, as a box, then the
+/// receiver as a half-space.
+fn insert_surfaces(world: &mut PhysicsWorld, scene: &Scene, cfg: &ContinuationConfig) {
+    if let Some(table) = &scene.table {
+        let body = RigidBodyBuilder::fixed().translation(table.center.as_vec3());
+        let h = table.half_extents.as_vec3();
+        let collider = ColliderBuilder::cuboid(h.x, h.y, h.z)
+            .restitution(cfg.restitution as f32)
+            .friction(cfg.friction as f32);
+        world.insert(body, collider);
+    }
+    // The receiver is a real surface (a floor or a wall): bodies must not pass through it.
+    let rc = &scene.receiver;
+    let body = RigidBodyBuilder::fixed().translation(rc.center.as_vec3());
+    let collider = ColliderBuilder::new(SharedShape::halfspace(rc.normal.as_vec3()))
+        .restitution(cfg.restitution as f32)
+        .friction(cfg.friction as f32);
+    world.insert(body, collider);
+}
+
+/// Insert one dynamic body per occluder in its `start` state, its velocity lowered by
+/// `half_gh` (see the module's notes), with our mass properties and a zero-density
+/// collider; returns the bodies' and colliders' handles in occluder order.
+fn insert_bodies(
+    world: &mut PhysicsWorld,
+    scene: &Scene,
+    start: &[BodyState],
+    half_gh: DVec3,
+    cfg: &ContinuationConfig,
+) -> (Vec<RigidBodyHandle>, Vec<ColliderHandle>) {
+    let mut handles: Vec<RigidBodyHandle> = Vec::with_capacity(start.len());
+    let mut colliders: Vec<ColliderHandle> = Vec::with_capacity(start.len());
+    for (o, s) in scene.occluders.iter().zip(start) {
+        let mp = &o.mass;
+        let mprops = MassProperties::with_principal_inertia_frame(
+            mp.local_com.as_vec3(),
+            mp.mass as f32,
+            mp.principal_inertia.as_vec3(),
+            mp.principal_frame.as_quat(),
+        );
+        let body = RigidBodyBuilder::dynamic()
+            .pose(Pose::from_parts(
+                s.origin.as_vec3(),
+                s.orientation.as_quat(),
+            ))
+            .linvel((s.velocity - half_gh).as_vec3())
+            .angvel(s.angular_velocity.as_vec3())
+            .additional_mass_properties(mprops)
+            .allow_fast_rotation(true)
+            .ccd_enabled(true);
+        let collider = match &o.shape {
+            Shape::Sphere { radius } => ColliderBuilder::ball(*radius as f32),
+            Shape::Cuboid { half_extents } => {
+                let e = half_extents.as_vec3();
+                ColliderBuilder::cuboid(e.x, e.y, e.z)
+            }
+            Shape::Mesh(m) => {
+                let pts: Vec<_> = m.vertices.iter().map(|v| v.as_vec3()).collect();
+                ColliderBuilder::new(mesh_hull(&pts, o.bounding_radius))
+            }
+        }
+        .density(0.0)
+        .restitution(cfg.restitution as f32)
+        .friction(cfg.friction as f32);
+        let (handle, collider) = world.insert(body, collider);
+        handles.push(handle);
+        colliders.push(collider);
+    }
+    (handles, colliders)
 }
 
 /// Each body's [`point_speed`] between the last two recorded keys.

@@ -182,8 +182,36 @@ pub fn write_glb_with_launches(
     }
     let mut b = Builder::new();
 
-    let mut scene_nodes = Vec::new();
+    let occluder_nodes = occluder_nodes(&mut b, scene, traj, launches)?;
+    let mut scene_nodes = occluder_nodes.clone();
+    surface_nodes(&mut b, scene, &mut scene_nodes)?;
+    scene_nodes.push(light_node(&mut b, scene));
 
+    let (w_px, h_px) = (scene.target.width(), scene.target.height());
+    scene_nodes.push(shadow_camera(&mut b, scene, w_px, h_px)?);
+    scene_nodes.push(view_camera(&mut b, scene, traj));
+
+    flight_animation(&mut b, traj, &occluder_nodes)?;
+
+    let extras = scene_extras(scene, traj);
+    let gltf_scene = b.root.push(json::Scene {
+        extensions: None,
+        extras: Some(serde_json::value::to_raw_value(&extras)?),
+        name: Some(scene.name.clone()),
+        nodes: scene_nodes,
+    });
+    b.root.scene = Some(gltf_scene);
+    b.finish()
+}
+
+/// One node per occluder, in occluder order, carrying its mesh, its material, its pose
+/// at `t` and its launch in `extras`; returns the nodes, which the animation targets.
+fn occluder_nodes(
+    b: &mut Builder,
+    scene: &Scene,
+    traj: &Track,
+    launches: Option<&[LaunchRow]>,
+) -> Result<Vec<Index<json::Node>>, GltfError> {
     // Occluders: node i is occluder i, which `read_poses_at` does not rely on but keeps
     // the file easy to read.
     let n = scene.occluders.len();
@@ -220,16 +248,7 @@ pub fn write_glb_with_launches(
         }
         let mesh = b.mesh(&occ.name, &data, material)?;
         let (o, q) = traj.poses[traj.t_index][i];
-        let extras = match launches.map(|l| &l[i]) {
-            Some(l) => serde_json::json!({
-                "scene": scene.name,
-                "launched": l.launched,
-                "mass_kg": l.mass_kg,
-                "launch_velocity_m_s": [l.vx_m_s, l.vy_m_s, l.vz_m_s],
-                "angular_velocity_rad_s": [l.wx_rad_s, l.wy_rad_s, l.wz_rad_s],
-            }),
-            None => serde_json::json!({ "scene": scene.name }),
-        };
+        let extras = occluder_extras(scene, launches.map(|l| &l[i]));
         let node = b.root.push(json::Node {
             extras: Some(serde_json::value::to_raw_value(&extras)?),
             mesh: Some(mesh),
@@ -239,9 +258,31 @@ pub fn write_glb_with_launches(
             ..Default::default()
         });
         occluder_nodes.push(node);
-        scene_nodes.push(node);
     }
+    Ok(occluder_nodes)
+}
 
+/// An occluder node's `extras`: the scene's name, and the occluder's launch when given.
+fn occluder_extras(scene: &Scene, launch: Option<&LaunchRow>) -> serde_json::Value {
+    match launch {
+        Some(l) => serde_json::json!({
+            "scene": scene.name,
+            "launched": l.launched,
+            "mass_kg": l.mass_kg,
+            "launch_velocity_m_s": [l.vx_m_s, l.vy_m_s, l.vz_m_s],
+            "angular_velocity_rad_s": [l.wx_rad_s, l.wy_rad_s, l.wz_rad_s],
+        }),
+        None => serde_json::json!({ "scene": scene.name }),
+    }
+}
+
+/// Push onto `scene_nodes` the receiver's node and, if the scene has a table, the
+/// table's.
+fn surface_nodes(
+    b: &mut Builder,
+    scene: &Scene,
+    scene_nodes: &mut Vec<Index<json::Node>>,
+) -> Result<(), GltfError> {
     // Receiver: a white quad around the image rectangle, front face towards the light.
     let rc = &scene.receiver;
     let white = b.material("white", [1.0, 1.0, 1.0, 1.0], 1.0);
@@ -270,8 +311,12 @@ pub fn write_glb_with_launches(
             ..Default::default()
         }));
     }
+    Ok(())
+}
 
-    // Point light (KHR_lights_punctual): intensity in candela, infinite range.
+/// The point light's node (KHR_lights_punctual, declared as used): intensity in candela
+/// ([`light_intensity_cd`]), infinite range.
+fn light_node(b: &mut Builder, scene: &Scene) -> Index<json::Node> {
     let light = b
         .root
         .push(json::extensions::scene::khr_lights_punctual::Light {
@@ -294,19 +339,19 @@ pub fn write_glb_with_launches(
         ),
         ..Default::default()
     };
-    scene_nodes.push(b.root.push(json::Node {
+    b.root.push(json::Node {
         name: Some("light".into()),
         translation: Some(to_f32(pos_to_gltf(scene.light))),
         extensions: Some(light_ext),
         ..Default::default()
-    }));
+    })
+}
 
+/// The glTF scene's `extras`: the instant `t` (also as a frame), the timestep, the
+/// target's size and the generator; with several instants, each picture's instant and
+/// the hold window.
+fn scene_extras(scene: &Scene, traj: &Track) -> serde_json::Value {
     let (w_px, h_px) = (scene.target.width(), scene.target.height());
-    scene_nodes.push(shadow_camera(&mut b, scene, w_px, h_px)?);
-    scene_nodes.push(view_camera(&mut b, scene, traj));
-
-    flight_animation(&mut b, traj, &occluder_nodes)?;
-
     let mut extras = serde_json::json!({
         "t": scene.t,
         "fps": traj.fps,
@@ -336,14 +381,7 @@ pub fn write_glb_with_launches(
             extras["hold_window_s"] = serde_json::json!(h.window);
         }
     }
-    let gltf_scene = b.root.push(json::Scene {
-        extensions: None,
-        extras: Some(serde_json::value::to_raw_value(&extras)?),
-        name: Some(scene.name.clone()),
-        nodes: scene_nodes,
-    });
-    b.root.scene = Some(gltf_scene);
-    b.finish()
+    extras
 }
 
 // ---------------------------------------------------------------------------------

@@ -86,12 +86,15 @@ struct Pen {
     dashed: bool,
 }
 
+/// A chart with linear f64 axes, as every plot here draws on.
+type Chart<'a, DB> = ChartContext<
+    'a,
+    DB,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
 fn draw_line<DB: DrawingBackend>(
-    chart: &mut ChartContext<
-        '_,
-        DB,
-        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
-    >,
+    chart: &mut Chart<'_, DB>,
     points: Vec<(f64, f64)>,
     pen: Pen,
 ) -> Result<(), DrawError> {
@@ -287,6 +290,15 @@ const BEST_PEN: Pen = Pen {
     dashed: true,
 };
 
+/// The convergence plot's axes: decades `lo..hi` of the log energy axis and `n` samples
+/// along x (at least 2, so that the range is not empty).
+#[derive(Clone, Copy)]
+struct Axes {
+    lo: i32,
+    hi: i32,
+    n: f64,
+}
+
 impl Draw for ConvergencePlot<'_> {
     fn size(&self) -> (u32, u32) {
         (1200, 560)
@@ -299,9 +311,31 @@ impl Draw for ConvergencePlot<'_> {
         let (plot_area, legend_area) = root.split_horizontally(w - LEGEND_WIDTH);
         let (lo, hi) = decade_range(data);
         let n = data.rows.len().max(2) as f64;
-        let mut chart = ChartBuilder::on(&plot_area)
+        let axes = Axes { lo, hi, n };
+        let mut chart = self.chart(&plot_area, axes)?;
+        self.draw_stages(&mut chart, &plot_area, axes)?;
+        let legend = self.draw_energies(&mut chart)?;
+        legend_area
+            .draw_text("terms (weighted)", &font(15), (4, 40))
+            .map_err(e)?;
+        draw_legend(&legend_area, 66, &legend)
+    }
+}
+
+impl ConvergencePlot<'_> {
+    /// The chart on `plot_area` with its caption, grid and labelled axes drawn.
+    fn chart<'a, DB: DrawingBackend>(
+        &self,
+        plot_area: &'a DrawingArea<DB, Shift>,
+        axes: Axes,
+    ) -> Result<Chart<'a, DB>, DrawError> {
+        let Axes { lo, hi, n } = axes;
+        let mut chart = ChartBuilder::on(plot_area)
             .caption(
-                format!("{}: weighted energy per generation, by stage", data.scene),
+                format!(
+                    "{}: weighted energy per generation, by stage",
+                    self.data.scene
+                ),
                 font(20),
             )
             .margin(12)
@@ -322,9 +356,19 @@ impl Draw for ConvergencePlot<'_> {
             .axis_desc_style(font(15))
             .draw()
             .map_err(e)?;
+        Ok(chart)
+    }
 
-        // Stage boundaries: a grey line where each stage after the first starts, and
-        // every stage's number and name at the top of its span.
+    /// Stage boundaries: a grey line where each stage after the first starts, and
+    /// every stage's number and name at the top of its span.
+    fn draw_stages<DB: DrawingBackend>(
+        &self,
+        chart: &mut Chart<'_, DB>,
+        plot_area: &DrawingArea<DB, Shift>,
+        axes: Axes,
+    ) -> Result<(), DrawError> {
+        let data = self.data;
+        let Axes { lo, hi, n } = axes;
         let pixel_width = f64::from(chart.plotting_area().dim_in_pixel().0);
         let mut starts: Vec<(usize, usize)> = Vec::new();
         for (i, r) in data.rows.iter().enumerate() {
@@ -385,12 +429,21 @@ impl Draw for ConvergencePlot<'_> {
                     .map_err(e)?;
             }
         }
+        Ok(())
+    }
 
+    /// The energy lines: the total and every non-zero term of each generation's best
+    /// sample, then the best total so far; returns their legend entries in that order.
+    fn draw_energies<DB: DrawingBackend>(
+        &self,
+        chart: &mut Chart<'_, DB>,
+    ) -> Result<Vec<(Pen, String)>, DrawError> {
+        let data = self.data;
         let bests = generation_bests(&data.rows);
         // The total first and wide, so that a term equal to it (XOR late in a solve)
         // stays visible as a coloured line inside the black one.
         for run in runs(&bests, |r| r.total) {
-            draw_line(&mut chart, run, TOTAL_PEN)?;
+            draw_line(chart, run, TOTAL_PEN)?;
         }
         let n_terms = data.rows.iter().map(|r| r.terms.len()).max().unwrap_or(0);
         let mut legend = Vec::new();
@@ -401,7 +454,7 @@ impl Draw for ConvergencePlot<'_> {
                 continue; // zero throughout: only noise in the legend
             }
             for run in series {
-                draw_line(&mut chart, run, pen)?;
+                draw_line(chart, run, pen)?;
             }
             let name = data
                 .term_names
@@ -411,32 +464,37 @@ impl Draw for ConvergencePlot<'_> {
             legend.push((pen, name));
         }
         legend.push((TOTAL_PEN, "total (best of generation)".to_string()));
-        // Best so far within each stage: the running minimum of every sample's total.
-        let mut best_runs: Vec<Vec<(f64, f64)>> = Vec::new();
-        let mut best = f64::INFINITY;
-        let mut prev_stage = None;
-        for (i, r) in data.rows.iter().enumerate() {
-            if prev_stage != Some(r.stage) {
-                best = f64::INFINITY;
-                best_runs.push(Vec::new());
-            }
-            prev_stage = Some(r.stage);
-            if r.total.is_finite() && r.total < best {
-                best = r.total;
-            }
-            if let (Some(l), Some(run)) = (log_value(best), best_runs.last_mut()) {
-                run.push((i as f64, l));
-            }
-        }
-        for run in best_runs.into_iter().filter(|r| r.len() > 1) {
-            draw_line(&mut chart, run, BEST_PEN)?;
+        for run in best_so_far_runs(&data.rows)
+            .into_iter()
+            .filter(|r| r.len() > 1)
+        {
+            draw_line(chart, run, BEST_PEN)?;
         }
         legend.push((BEST_PEN, "best total so far".to_string()));
-        legend_area
-            .draw_text("terms (weighted)", &font(15), (4, 40))
-            .map_err(e)?;
-        draw_legend(&legend_area, 66, &legend)
+        Ok(legend)
     }
+}
+
+/// Best so far within each stage: the running minimum of every sample's total, one run
+/// of (sample, log10) points per stage.
+fn best_so_far_runs(rows: &[ConvergenceRow]) -> Vec<Vec<(f64, f64)>> {
+    let mut best_runs: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut best = f64::INFINITY;
+    let mut prev_stage = None;
+    for (i, r) in rows.iter().enumerate() {
+        if prev_stage != Some(r.stage) {
+            best = f64::INFINITY;
+            best_runs.push(Vec::new());
+        }
+        prev_stage = Some(r.stage);
+        if r.total.is_finite() && r.total < best {
+            best = r.total;
+        }
+        if let (Some(l), Some(run)) = (log_value(best), best_runs.last_mut()) {
+            run.push((i as f64, l));
+        }
+    }
+    best_runs
 }
 
 /// The convergence plot: every weighted term and the total of each generation's best

@@ -114,6 +114,32 @@ impl ShadowCamera {
             self.rasterize_triangles(world_vertices, triangles, true, mask, scratch);
             return;
         }
+        let Some((row_min, row_max)) = self.silhouette_edges(p, q, mesh, light_local, scratch)
+        else {
+            return;
+        };
+        self.fill_silhouette(row_min as usize, row_max as usize, mask, scratch);
+    }
+
+    /// Gather the silhouette edges of `mesh` at pose `(p, q)`, seen from `light_local` (the
+    /// light in the body frame), into `scratch.sil_edges`: each projected to pixels,
+    /// oriented as its front face runs it, with the rows whose centre it crosses. Returns
+    /// the first and last of those rows over all edges, or `None` when no edge crosses a
+    /// row centre (nothing to fill).
+    #[inline]
+    fn silhouette_edges(
+        &self,
+        p: DVec3,
+        q: DQuat,
+        mesh: ClosedMesh<'_>,
+        light_local: DVec3,
+        scratch: &mut RasterScratch,
+    ) -> Option<(u32, u32)> {
+        let ClosedMesh {
+            vertices,
+            silhouette: sil,
+            ..
+        } = mesh;
         let nv = vertices.len();
         scratch.facing.clear();
         scratch
@@ -177,10 +203,18 @@ impl ShadowCamera {
             });
         }
         if scratch.sil_edges.is_empty() {
-            return;
+            return None;
         }
+        Some((row_min, row_max))
+    }
+
+    /// OR into `mask` rows `r0..=r1` of the polygons bounded by `scratch.sil_edges`, with
+    /// the non-zero winding rule: their crossings of each row centre are sorted by row
+    /// (counting sort into `scratch.crossings`) then by x, and every span where the
+    /// winding number is non-zero is filled.
+    #[inline]
+    fn fill_silhouette(&self, r0: usize, r1: usize, mask: &mut Mask, scratch: &mut RasterScratch) {
         // Counting sort of the crossings by row.
-        let (r0, r1) = (row_min as usize, row_max as usize);
         let rows = r1 - r0 + 1;
         scratch.row_start.clear();
         scratch.row_start.resize(rows + 1, 0);
