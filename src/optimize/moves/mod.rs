@@ -304,11 +304,7 @@ pub fn improve(
         blocks,
         meshes,
     } = Bodies::of(scene, vary);
-    let trades = if options.trades {
-        trade_groups(scene, [&blocks, &meshes])
-    } else {
-        Vec::new()
-    };
+    let trades = trade_groups(scene, [&blocks, &meshes], options.trades);
     if movable.is_empty() || (options.trades && trades.is_empty()) {
         return report;
     }
@@ -407,14 +403,15 @@ pub fn improve(
     }
 }
 
-/// The groups of bodies that trade places: the blocks, and the meshes where few
-/// enough, each group only where its shapes differ.
-fn trade_groups<'a>(scene: &Scene, groups: [&'a [usize]; 2]) -> Vec<&'a [usize]> {
+/// The groups of bodies that trade places (none unless `trades`): the blocks, and the
+/// meshes where few enough, each group only where its shapes differ.
+fn trade_groups<'a>(scene: &Scene, groups: [&'a [usize]; 2], trades: bool) -> Vec<&'a [usize]> {
     let shape = |i: usize| &scene.occluders[i].shape;
     groups
         .into_iter()
         .filter(|group| {
-            group.iter().any(|&i| shape(i) != shape(group[0]))
+            trades
+                && group.iter().any(|&i| shape(i) != shape(group[0]))
                 && (group.len() * group.len().saturating_sub(1) <= MAX_MESH_TRADES
                     || fits_pose(shape(group[0])))
         })
