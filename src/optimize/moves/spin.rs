@@ -44,7 +44,7 @@ pub(super) const CHORD_STEPS: usize = 6;
 
 /// Rotation per RK4 step (rad, at the fastest the body's spin may get) of the coarse
 /// flight on which [`spin_reaching`] runs Newton's method: about 1e-4 of the turn's error
-/// at `t`, where the exact flight's steps of 0.05 rad cost twice as much.
+/// at `t`, where the exact flight's steps of 0.02 rad cost five times as much.
 pub(super) const COARSE_ANGLE: f64 = 0.1;
 
 /// The launch spin that turns body `i` to the orientation `want` at `t` in free flight,
