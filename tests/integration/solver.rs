@@ -5,6 +5,7 @@
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use bsa::evaluate::Problem;
+use bsa::optimize::moves::Purpose;
 use bsa::optimize::solver::{self, Observer, Schedule, SolveOptions};
 use bsa::output::solution::{SampleRecord, Solution};
 
@@ -417,7 +418,7 @@ fn run_moves_of(
     params: &mut [f64],
     rank: &dyn Fn(&bsa::evaluate::Evaluation) -> f64,
 ) -> Moved {
-    run_moves_trading(p, vary, params, rank, false)
+    run_moves_for(p, vary, params, rank, Purpose::Stage)
 }
 
 /// What a call of the moves did: the IoU before, the evaluation after, its report.
@@ -427,13 +428,13 @@ type Moved = (
     bsa::optimize::moves::MoveReport,
 );
 
-/// [`run_moves_of`], with or without trades of places among bodies.
-fn run_moves_trading(
+/// [`run_moves_of`], for a stage's moves or for the trades.
+fn run_moves_for(
     p: &Problem,
     vary: &[usize],
     params: &mut [f64],
     rank: &dyn Fn(&bsa::evaluate::Evaluation) -> f64,
-    trades: bool,
+    purpose: Purpose,
 ) -> Moved {
     let w = p.scene.stages.last().unwrap().weights;
     let mut ws = p.workspace();
@@ -450,10 +451,8 @@ fn run_moves_trading(
         &mut best,
         bsa::optimize::moves::MoveOptions {
             max_moves: 2,
-            polish_single: true,
-            trades,
-            seat_blocks: false,
-            evolve_fits: false,
+            settled: true,
+            purpose,
         },
         &mut ws,
         &mut |_| {},
@@ -618,11 +617,13 @@ fn trades_mend_three_blocks_of_three_sizes_each_on_the_next_ones_part() {
     let stuck = launch_file(&p, &dir.join("stuck.json"));
     let vary: Vec<usize> = (0..p.scene.occluders.len()).collect();
     let mut params = stuck.clone();
-    let (before, best, _) = run_moves_trading(&p, &vary, &mut params, &contact_free_first, false);
+    let (before, best, _) =
+        run_moves_for(&p, &vary, &mut params, &contact_free_first, Purpose::Stage);
     assert!(before < 0.965, "IoU {before}");
     assert!(best.iou < before + 0.002, "IoU {before} -> {}", best.iou);
     let mut params = stuck;
-    let (_, best, report) = run_moves_trading(&p, &vary, &mut params, &contact_free_first, true);
+    let (_, best, report) =
+        run_moves_for(&p, &vary, &mut params, &contact_free_first, Purpose::Trade);
     assert!(report.accepted >= 1, "{report:?}");
     // 0.9721 when written.
     assert!(best.iou > 0.97, "IoU {before} -> {}", best.iou);

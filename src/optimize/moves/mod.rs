@@ -161,7 +161,7 @@ pub struct MoveReport {
     /// The energy of the launch kept without the contact term (as [`Exchange::free`]).
     pub kept_free: f64,
     /// The trades of meshes of the last pass of a call that trades
-    /// ([`MoveOptions::trades`]), as seated and polished, best picture first, even those
+    /// ([`Purpose::Trade`]), as seated and polished, best picture first, even those
     /// that draw a worse picture than the launch kept (up to [`TRADE_SLACK`] times its
     /// wrong pixels): a trade in a cluster of overlapping pieces draws a worse picture
     /// until the pieces around have moved to make room, which a local search of the
@@ -246,36 +246,64 @@ struct Offer {
     eval: Evaluation,
 }
 
-/// How far [`improve`] goes.
+/// How far [`improve`] goes, from what, and what for.
 #[derive(Clone, Copy, Debug)]
 pub struct MoveOptions {
     /// Moves taken at most (passes that end with a move).
     pub max_moves: usize,
-    /// Polish the moves of one body too, not only the swaps. A caller leaves it off where
-    /// the best is not yet a local optimum of its own (the first run of a stage that
-    /// places one body): there, a move's gain over an unrefined start says little of
-    /// where the search ends (on the 飞 example, a polished turn taken so left the hook
-    /// stroke 0.004 of IoU worse).
-    pub polish_single: bool,
-    /// Trade places among bodies of one kind and different shapes, and seat the meshes,
-    /// in every pass ([`Seats::trade_scan`](seats::Seats::trade_scan)); a call that asks
-    /// for trades where no group may trade (no two blocks of different sizes, and no two
-    /// meshes of different shapes among at most [`MAX_MESH_TRADES`] ordered pairs)
-    /// moves nothing.
-    pub trades: bool,
-    /// Seat the blocks on their own places too, as the meshes are, in every pass (a
-    /// block tilted the wrong way, its outline near its part's). The last stage's polish
-    /// asks for it; the stages' calls do not: there it lowered as many planted block
-    /// problems as it raised (a seat taken early leaves a block's part to the runs after
-    /// it in a pose that is not yet its own).
-    pub seat_blocks: bool,
-    /// Refine each fit of a block by CMA-ES over its pose after the compass search
-    /// ([`fit_pose`](pose::fit_pose)'s `thorough`). The last stage's polish asks for it;
-    /// the stages' calls do not: there, on the 35 planted problems of seeds 11400 to
-    /// 11406, it raised 12 and lowered 8 (boxes 11402 0.9847 to 0.9955, but boxes12 11401
-    /// 0.9960 to 0.9724), where in the polish alone, whose moves are kept only where the
-    /// picture is no worse, it raised 8 and lowered 1 (by 0.0001).
-    pub evolve_fits: bool,
+    /// Whether the best is a local optimum of its own search (a restart's start, a
+    /// stage of several bodies, the polish): then the moves of one body are polished
+    /// too, not only the swaps. Where it is not (the first run of a stage that places
+    /// one body), a move's gain over an unrefined start says little of where the search
+    /// ends (on the 飞 example, a polished turn taken so left the hook stroke 0.004 of
+    /// IoU worse).
+    pub settled: bool,
+    pub purpose: Purpose,
+}
+
+/// What a call of [`improve`] is for: the pass that calls it. What each purpose's
+/// rounds do beyond the moves every round offers is this table
+/// ([`Purpose::trades`], [`Purpose::seats_blocks`], [`Purpose::evolves_fits`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Purpose {
+    /// A stage's moves before its runs.
+    Stage,
+    /// The last stage's trades: bodies of one kind and different shapes trade places,
+    /// and the meshes are seated, in every pass
+    /// ([`Seats::trade_scan`](seats::Seats::trade_scan)); where no group may trade (no
+    /// two blocks of different sizes, and no two meshes of different shapes among at
+    /// most [`MAX_MESH_TRADES`] ordered pairs) nothing moves.
+    Trade,
+    /// The last stage's polish: the blocks are seated on their own places too, as the
+    /// meshes are, in every pass (a block tilted the wrong way, its outline near its
+    /// part's), and each fit of a block is refined by CMA-ES over its pose after the
+    /// compass search ([`fit_pose`](pose::fit_pose)'s `thorough`).
+    ///
+    /// Neither in the stages' moves: there, seating the blocks lowered as many planted
+    /// block problems as it raised (a seat taken early leaves a block's part to the runs
+    /// after it in a pose that is not yet its own), and the refined fits raised 12 and
+    /// lowered 8 of the 35 planted problems of seeds 11400 to 11406 (boxes 11402 0.9847
+    /// to 0.9955, but boxes12 11401 0.9960 to 0.9724), where in the polish alone, whose
+    /// moves are kept only where the picture is no worse, they raised 8 and lowered 1
+    /// (by 0.0001).
+    Polish,
+}
+
+impl Purpose {
+    /// Whether bodies trade places in every pass.
+    pub fn trades(self) -> bool {
+        self == Purpose::Trade
+    }
+
+    /// Whether the blocks are seated on their own places in every pass.
+    pub fn seats_blocks(self) -> bool {
+        self == Purpose::Polish
+    }
+
+    /// Whether each fit of a block is refined by CMA-ES over its pose.
+    pub fn evolves_fits(self) -> bool {
+        self == Purpose::Polish
+    }
 }
 
 /// Greedy moves of the occluders in `vary` from `params` (the launch of every
@@ -304,8 +332,8 @@ pub fn improve(
         blocks,
         meshes,
     } = Bodies::of(scene, vary);
-    let trades = trade_groups(scene, [&blocks, &meshes], options.trades);
-    if movable.is_empty() || (options.trades && trades.is_empty()) {
+    let trades = trade_groups(scene, [&blocks, &meshes], options.purpose.trades());
+    if movable.is_empty() || (options.purpose.trades() && trades.is_empty()) {
         return report;
     }
     let mut search = Search {
@@ -480,7 +508,7 @@ fn exchange_pairs(scene: &crate::scene::Scene, movable: &[usize]) -> usize {
 }
 
 /// Slide the [`POLISHED`] best of `offers` (sorted best first; those of one body only
-/// where `options.polish_single`) in depth ([`Search::polish`]), and fit the blocks of
+/// where `options.settled`) in depth ([`Search::polish`]), and fit the blocks of
 /// the best one and of every polished swap on their new poses
 /// ([`fit_and_launch`]), keeping a fit that draws a better
 /// picture. A block turned onto another face, or sent to a new part, rarely has its
@@ -502,7 +530,7 @@ fn polish_best(
         if polished == POLISHED {
             break;
         }
-        if !(options.polish_single || offer.bodies.len() > 1) {
+        if !(options.settled || offer.bodies.len() > 1) {
             continue;
         }
         offer.eval = out
@@ -523,7 +551,7 @@ fn polish_best(
                 vary,
                 b,
                 out.candidate,
-                options.evolve_fits,
+                options.purpose.evolves_fits(),
                 out.ws,
                 out.flight,
             );

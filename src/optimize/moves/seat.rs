@@ -24,7 +24,8 @@ pub(super) struct Seat;
 
 impl Move for Seat {
     fn offer(&self, r: &Round, out: &mut Offers) {
-        if !(r.first || r.options.trades || r.options.seat_blocks) {
+        let purpose = r.options.purpose;
+        if !(r.first || purpose.trades() || purpose.seats_blocks()) {
             return;
         }
         let problem = r.problem;
@@ -36,7 +37,7 @@ impl Move for Seat {
             sights: &r.sights,
         };
         // Each on its own place (the blocks too where the caller asks) ...
-        let own: Vec<usize> = if r.options.seat_blocks {
+        let own: Vec<usize> = if purpose.seats_blocks() {
             r.meshes.iter().chain(r.blocks).copied().collect()
         } else {
             r.meshes.to_vec()
@@ -145,7 +146,7 @@ impl Move for PoseFit {
                 r.vary,
                 i,
                 out.candidate,
-                r.options.evolve_fits,
+                r.options.purpose.evolves_fits(),
                 out.ws,
                 out.flight,
             ) {

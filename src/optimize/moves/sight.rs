@@ -303,7 +303,7 @@ pub(super) fn lays(
 /// the planted problems' six chess pieces make 15 pairs.
 pub(super) const MAX_EXCHANGE_PAIRS: usize = 30;
 
-/// Meshes trade places ([`MoveOptions::trades`](super::MoveOptions::trades)) where at most this many ordered pairs
+/// Meshes trade places ([`Purpose::Trade`](super::Purpose::Trade)) where at most this many ordered pairs
 /// of them are scanned: the six pieces of the planted chess problems make 30, each
 /// scan drawing a few thousand shadows of a mesh; THE THINKER's sixteen would make 240,
 /// several seconds over its solve. Blocks, whose shadows are eight corners, always

@@ -123,7 +123,7 @@ pub(super) fn trade_trials(
 }
 
 /// The last stage's polish: first the moves with every block seated anew on its own
-/// place (`moves::improve` with `seat_blocks`), then each of the stage's bodies in turn,
+/// place (`moves::improve` for [`moves::Purpose::Polish`]), then each of the stage's bodies in turn,
 /// the others held, refined by one CMA-ES run with the settings of `template` (the
 /// scene's last stage of one body) but a tenth of its step ([`POLISH_STEP_SHARE`]), from
 /// the best launch so far (`best`: the launch and its evaluation under `stage`'s
@@ -182,7 +182,7 @@ pub(super) fn polish(
 
 /// The polish's first step: the moves of `stage`'s bodies from `params` (evaluated as
 /// `best`, both updated in place), every block seated anew on its own place in every
-/// pass (`seat_blocks`). Returns the samples drawn and the moves taken (none when
+/// pass ([`moves::Purpose::Polish`]). Returns the samples drawn and the moves taken (none when
 /// their end drew a worse picture, which is then not kept).
 ///
 /// A block tilted the other way, or on another face, draws an outline near its part's
@@ -213,10 +213,8 @@ fn polish_moves(
         best,
         moves::MoveOptions {
             max_moves: stage.vary.len(),
-            polish_single: true,
-            trades: false,
-            seat_blocks: true,
-            evolve_fits: true,
+            settled: true,
+            purpose: moves::Purpose::Polish,
         },
         ws,
         record,

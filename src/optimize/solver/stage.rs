@@ -20,7 +20,7 @@ use super::{IterationInfo, Observer};
 use crate::energy::{Term, Weights};
 use crate::evaluate::{Evaluation, Held, Problem, Workspace};
 use crate::optimize::cmaes::{Cmaes, CmaesConfig, StopReason};
-use crate::optimize::moves::{self, MoveOptions, MoveReport};
+use crate::optimize::moves::{self, MoveOptions, MoveReport, Purpose};
 use crate::output::solution::{PassRecord, SampleRecord};
 use crate::scene::Stage;
 use crate::shadow::mask::Mask;
@@ -88,7 +88,7 @@ pub(super) struct StageRun<'a> {
     /// improved on.
     run_start: Evaluation,
     /// The last round of moves before a run, and whether it traded.
-    moved: Option<(MoveReport, bool)>,
+    moved: Option<(MoveReport, Purpose)>,
     polish: Option<String>,
 }
 
@@ -239,8 +239,8 @@ impl<'a> StageRun<'a> {
     }
 
     /// A round of moves from the best (see [`moves::improve`]), at most `max_moves`,
-    /// trading where `trades`; remembered for the next run's start.
-    fn round_of_moves(&mut self, max_moves: usize, trades: bool) {
+    /// for `purpose`; remembered for the next run's start.
+    fn round_of_moves(&mut self, max_moves: usize, purpose: Purpose) {
         let (problem, k, iteration) = (self.problem, self.k, self.iteration);
         let contacts = problem.scene.contacts;
         let weights = self.weights();
@@ -255,10 +255,8 @@ impl<'a> StageRun<'a> {
             &mut self.eval,
             MoveOptions {
                 max_moves,
-                polish_single: self.restart > 0 || self.given.vary.len() > 1,
-                trades,
-                seat_blocks: false,
-                evolve_fits: false,
+                settled: self.restart > 0 || self.given.vary.len() > 1,
+                purpose,
             },
             &mut self.ws,
             &mut |e: &Evaluation| records.push(sample_record(k, iteration, &weights, e)),
@@ -267,13 +265,13 @@ impl<'a> StageRun<'a> {
         if moved.accepted > 0 {
             self.mask.copy_from(&self.ws.mask);
         }
-        self.moved = Some((moved, trades));
+        self.moved = Some((moved, purpose));
     }
 
     /// [`Pass::Moves`]: a round of moves of as many moves as the stage has bodies.
     fn moves(&mut self) {
         self.run_start = self.eval;
-        self.round_of_moves(self.given.vary.len(), false);
+        self.round_of_moves(self.given.vary.len(), Purpose::Stage);
     }
 
     /// [`Pass::Exchanges`]: the moves' best exchanges refined (see [`exchange`]).
@@ -308,9 +306,9 @@ impl<'a> StageRun<'a> {
         let stage = self.given;
         loop {
             let start_from = match self.moved.take() {
-                Some((moved, trading)) => {
-                    moved.promising.filter(|_| moved.accepted == 0 || trading)
-                }
+                Some((moved, purpose)) => moved
+                    .promising
+                    .filter(|_| moved.accepted == 0 || purpose == Purpose::Trade),
                 None => {
                     self.moves();
                     let (moved, _) = self.moved.take().expect("the moves just ran");
@@ -456,7 +454,7 @@ impl<'a> StageRun<'a> {
     fn trades(&mut self) {
         let run_start = self.eval;
         self.rejudge(&self.weights());
-        self.round_of_moves(TRADE_MOVES.value as usize, true);
+        self.round_of_moves(TRADE_MOVES.value as usize, Purpose::Trade);
         let (moved, _) = self.moved.as_ref().expect("the moves just ran");
         if moved.accepted > 0 {
             self.run_start = run_start;
