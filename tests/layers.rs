@@ -1,7 +1,9 @@
 //! The layers point one way: every `crate::` path in the library's code names a module of
 //! the same or a lower layer, in the pipeline's order (docs/ARCHITECTURE.md). And only
 //! the modules docs/ARCHITECTURE.md names touch the file system. Test code (`tests.rs`
-//! files and everything from a file's first `#[cfg(test)]` on) may do either.
+//! files and everything from a file's first `#[cfg(test)]` on) may do either. And the
+//! code stays in pieces one can read: no function over [`MAX_FUNCTION_LINES`], no file
+//! over [`MAX_FILE_LINES`] before its tests.
 
 use std::path::{Path, PathBuf};
 
@@ -165,4 +167,105 @@ fn only_the_modules_named_in_the_architecture_touch_the_file_system() {
         FILE_SYSTEM.join(", "),
         wrong.join("\n")
     );
+}
+
+/// Lines of a function at most, from its `fn` line to its closing brace.
+const MAX_FUNCTION_LINES: usize = 120;
+
+/// Lines of a source file at most before its first `#[cfg(test)]`.
+const MAX_FILE_LINES: usize = 800;
+
+/// The change of brace depth over `line`, outside strings, characters and comments.
+/// `in_string` carries a string literal over lines.
+fn brace_change(line: &str, in_string: &mut bool) -> i64 {
+    let (mut change, mut chars) = (0, line.chars().peekable());
+    while let Some(c) = chars.next() {
+        if *in_string {
+            match c {
+                '\\' => {
+                    chars.next();
+                }
+                '"' => *in_string = false,
+                _ => {}
+            }
+            continue;
+        }
+        match c {
+            '"' => *in_string = true,
+            '/' if chars.peek() == Some(&'/') => break,
+            // A character literal: '{', '}', '"' or an escape.
+            '\'' => {
+                let rest: String = chars.clone().take(3).collect();
+                if rest.starts_with("\\") && rest.ends_with('\'') {
+                    chars.nth(2);
+                } else if rest.chars().nth(1) == Some('\'') {
+                    chars.nth(1);
+                }
+            }
+            '{' => change += 1,
+            '}' => change -= 1,
+            _ => {}
+        }
+    }
+    change
+}
+
+/// The name of the function a line begins, if it does.
+fn function_name(line: &str) -> Option<&str> {
+    let mut words = line.split_whitespace();
+    loop {
+        match words.next()? {
+            w if w == "pub" || w.starts_with("pub(") => {}
+            "const" | "async" | "unsafe" | "extern" => {}
+            "fn" => return words.next()?.split(['<', '(']).next(),
+            _ => return None,
+        }
+    }
+}
+
+#[test]
+fn no_function_is_over_120_lines_and_no_file_over_800_before_its_tests() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    sources(&src, &mut files);
+    files.sort();
+    let (mut functions, mut long) = (0, Vec::new());
+    for file in &files {
+        let rel = file.strip_prefix(&src).unwrap().display().to_string();
+        let text = std::fs::read_to_string(file).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        let before_tests = lines
+            .iter()
+            .position(|l| l.trim_start().starts_with("#[cfg(test)]"))
+            .unwrap_or(lines.len());
+        if file.file_name().unwrap() != "tests.rs" && before_tests > MAX_FILE_LINES {
+            long.push(format!("{rel}: {before_tests} lines before its tests"));
+        }
+        for (start, line) in lines.iter().enumerate() {
+            let Some(name) = function_name(line) else {
+                continue;
+            };
+            let (mut depth, mut opened, mut in_string) = (0, false, false);
+            for (k, l) in lines.iter().enumerate().skip(start) {
+                if !opened && l.trim_end().ends_with(';') && !l.contains('{') {
+                    break; // a declaration without a body
+                }
+                depth += brace_change(l, &mut in_string);
+                opened |= depth > 0;
+                if opened && depth == 0 {
+                    functions += 1;
+                    let n = k - start + 1;
+                    if n > MAX_FUNCTION_LINES {
+                        long.push(format!("{rel}:{}: fn {name}: {n} lines", start + 1));
+                    }
+                    break;
+                }
+            }
+        }
+    }
+    assert!(
+        functions > 1000,
+        "only {functions} functions found: is this the right folder?"
+    );
+    assert!(long.is_empty(), "too long:\n{}", long.join("\n"));
 }
