@@ -9,7 +9,7 @@
 //! A start guess's IoU says little of where its solve ends: on 27 held-out pictures the
 //! design with the best start was the best solved one for 12. So the designs are
 //! solved as `bsa solve` will solve them (the scene's seed and strategy,
-//! [`Schedule::TRIAL`]) in a race of successive halving ([`RUNGS`]).
+//! [`Schedule::TRIAL`]), side by side, in a race whose rungs ([`RUNGS`]) say how far.
 //!
 //! Each design's scene is written and loaded by the caller ([`Scenes`]: mesh paths are
 //! relative to the scene's folder), so that the trial solves the very scene `bsa new`
@@ -347,10 +347,14 @@ fn unless_interrupted<T>(
     work()
 }
 
-/// The share of its stages each rung of the race solves a design to: every design
-/// runs the first quarter, the better half of them the next quarter, the better half
-/// of those the rest (successive halving: half the samples of solving each to its end).
-pub const RUNGS: [f64; 3] = [0.25, 0.5, 1.0];
+/// The share of its stages each rung of the race solves a design to, the better half
+/// going on to the next rung (successive halving). One rung, every design to its end:
+/// rungs of a quarter and a half of the stages dropped the design that ends best in 6
+/// of the 35 planted problems of seeds 12000 to 12006 through `bsa new` and raised none
+/// (median 0.9968 to 0.9961), for a quarter less of `bsa new`'s time. A sequential
+/// solve places its bodies one by one, so its picture part way through says little of
+/// where it ends.
+pub const RUNGS: [f64; 1] = [1.0];
 
 /// Race the designs `entrants` (each with its index): each rung of [`RUNGS`] solves
 /// every design left to its share of the stages, resuming where the last rung left it,
@@ -368,14 +372,11 @@ pub fn race(
     let mut ended = Vec::new();
     let mut reached: Vec<Option<Solution>> = entrants.iter().map(|_| None).collect();
     for (r, share) in RUNGS.into_iter().enumerate() {
-        watch.begin(
-            entrants.len() as u64,
-            &format!(
-                "{name}: racing {} designs ({} of the stages)",
-                entrants.len(),
-                share
-            ),
-        );
+        let what = match share < 1.0 {
+            true => format!("racing {} designs ({share} of the stages)", entrants.len()),
+            false => format!("solving {} designs", entrants.len()),
+        };
+        watch.begin(entrants.len() as u64, &format!("{name}: {what}"));
         let solved: Vec<Solution> = entrants
             .par_iter()
             .zip(reached.par_iter_mut())
