@@ -163,7 +163,7 @@ fn print_json(scene: &Scene, terms: &Terms) -> Result<()> {
             )
         })
         .collect();
-    let v = serde_json::json!({
+    let mut v = serde_json::json!({
         "scene": scene.name,
         "stage": k,
         "terms": terms,
@@ -175,7 +175,6 @@ fn print_json(scene: &Scene, terms: &Terms) -> Result<()> {
         "shadows_outside_image": outside,
         "time_per_phase_us": timings.iter().map(|(k, v)| (k.clone(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
     });
-    let mut v = v;
     if !frame_ious.is_empty() {
         v["frames"] = frame_ious
             .iter()

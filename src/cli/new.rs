@@ -447,8 +447,8 @@ struct DesignFiles<'a>(&'a [PathBuf]);
 impl Scenes for DesignFiles<'_> {
     fn load(&self, k: usize, json: &Value) -> Result<Scene, SearchError> {
         let text = serde_json::to_string_pretty(json).expect("a JSON value serialises");
-        let boxed = |e| SearchError::Scenes(Box::new(e));
-        files::write_atomic(&self.0[k], text.as_bytes()).map_err(boxed)?;
+        files::write_atomic(&self.0[k], text.as_bytes())
+            .map_err(|e| SearchError::Scenes(Box::new(e)))?;
         crate::scene::load(&self.0[k]).map_err(|e| SearchError::Scenes(Box::new(e)))
     }
 }
