@@ -5,8 +5,8 @@
 //! any solve.
 //!
 //! The sets are data: `tools/test-pictures/set-NN/manifest.json` lists each picture's
-//! name, how it is drawn (`"glyph"` a character and `"dilate"` pixels, or `"drawn"` the
-//! name of a shape of [`DRAWN`]), its objects as `bsa new --objects` takes them, and any
+//! name, how it is drawn (`"glyph"` a character and `"dilate"` pixels, `"drawn"` the
+//! name of a shape of [`DRAWN`], or `"parts"` a silhouette as a list of [`Part`]s), its objects as `bsa new --objects` takes them, and any
 //! extra `bsa new` options; its `"about"` says when the set was drawn and how its
 //! objects were stated. `scripts/new-suite.sh` reads the same manifests.
 //!
@@ -42,6 +42,8 @@ struct Picture {
     dilate: usize,
     /// The name of a drawn shape of [`DRAWN`].
     drawn: Option<String>,
+    /// A silhouette made of parts, drawn in order.
+    parts: Option<Vec<Part>>,
     /// The objects, as `bsa new --objects` takes them.
     objects: String,
     /// Extra `bsa new` options.
@@ -58,6 +60,76 @@ struct Manifest {
     #[allow(dead_code)]
     about: String,
     pictures: Vec<Picture>,
+}
+
+/// A part of a silhouette, in pixels, centred on the frame with y up: each part adds
+/// its points to the silhouette drawn so far, or with `cut` takes them away (a cup's
+/// handle: a ring, then the body over it).
+#[derive(Deserialize)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
+enum Part {
+    /// An ellipse: centre, semi-axes along x and y, turned by `turn` degrees.
+    Ellipse {
+        centre: [f64; 2],
+        radii: [f64; 2],
+        #[serde(default)]
+        turn: f64,
+    },
+    /// A polyline of `width` with round joins and ends.
+    Stroke { points: Vec<[f64; 2]>, width: f64 },
+    /// A polygon (even-odd rule).
+    Polygon { points: Vec<[f64; 2]> },
+    /// The points of the part taken away.
+    Cut(Box<Part>),
+}
+
+impl Part {
+    /// Whether the part holds (x, y); for a `cut`, whether its own part does.
+    fn holds(&self, x: f64, y: f64) -> bool {
+        match self {
+            Part::Ellipse {
+                centre,
+                radii,
+                turn,
+            } => {
+                let (s, c) = turn.to_radians().sin_cos();
+                let (dx, dy) = (x - centre[0], y - centre[1]);
+                let (u, v) = (dx * c + dy * s, -dx * s + dy * c);
+                (u / radii[0]).powi(2) + (v / radii[1]).powi(2) <= 1.0
+            }
+            Part::Stroke { points, width } => {
+                points.windows(2).any(|w| {
+                    let ([ax, ay], [bx, by]) = (w[0], w[1]);
+                    let (dx, dy) = (bx - ax, by - ay);
+                    let len2 = (dx * dx + dy * dy).max(f64::MIN_POSITIVE);
+                    let s = (((x - ax) * dx + (y - ay) * dy) / len2).clamp(0.0, 1.0);
+                    (x - ax - s * dx).hypot(y - ay - s * dy) <= width / 2.0
+                }) || (points.len() == 1
+                    && (x - points[0][0]).hypot(y - points[0][1]) <= width / 2.0)
+            }
+            Part::Polygon { points } => {
+                let mut inside = false;
+                for k in 0..points.len() {
+                    let (a, b) = (points[k], points[(k + 1) % points.len()]);
+                    if (a[1] > y) != (b[1] > y)
+                        && x < a[0] + (y - a[1]) * (b[0] - a[0]) / (b[1] - a[1])
+                    {
+                        inside = !inside;
+                    }
+                }
+                inside
+            }
+            Part::Cut(p) => p.holds(x, y),
+        }
+    }
+}
+
+/// Whether the silhouette of `parts` holds (x, y).
+fn in_parts(parts: &[Part], x: f64, y: f64) -> bool {
+    parts.iter().fold(false, |inside, p| match p {
+        Part::Cut(_) => inside && !p.holds(x, y),
+        _ => inside || p.holds(x, y),
+    })
 }
 
 /// The drawn shapes a manifest names: point-sets drawn by supersampling, true inside,
@@ -524,7 +596,7 @@ fn dilated(on: &[bool], r: usize) -> Vec<bool> {
     out
 }
 
-fn drawn(f: ShapeFn) -> Vec<bool> {
+fn drawn(f: impl Fn(f64, f64) -> bool) -> Vec<bool> {
     (0..W * H)
         .map(|k| {
             let (x, y) = ((k % W) as f64, (k / W) as f64);
@@ -561,9 +633,10 @@ fn parse_char(g: &str) -> Result<char, Box<dyn Error>> {
 
 /// The picture's pixels, true for shadow.
 fn draw(font: &FontRef, p: &Picture) -> Result<Vec<bool>, Box<dyn Error>> {
-    match (&p.glyph, &p.drawn) {
-        (Some(g), None) => glyph(font, parse_char(g)?, p.dilate),
-        (None, Some(d)) => {
+    match (&p.glyph, &p.drawn, &p.parts) {
+        (Some(g), None, None) => glyph(font, parse_char(g)?, p.dilate),
+        (None, None, Some(parts)) => Ok(drawn(|x, y| in_parts(parts, x, y))),
+        (None, Some(d), None) => {
             let f = DRAWN
                 .iter()
                 .find(|(n, _)| n == d)
@@ -571,7 +644,7 @@ fn draw(font: &FontRef, p: &Picture) -> Result<Vec<bool>, Box<dyn Error>> {
                 .1;
             Ok(drawn(f))
         }
-        _ => Err(format!("{}: give one of \"glyph\" and \"drawn\"", p.name).into()),
+        _ => Err(format!("{}: give one of \"glyph\", \"drawn\" and \"parts\"", p.name).into()),
     }
 }
 

@@ -14,6 +14,8 @@
 # Scenes and solves go to /tmp/bsa-new-suite[-2][-auto]/<picture>/ and <picture>-out/
 # (with <picture>-new.log, what `bsa new` printed);
 # the contact sheet to docs/images/new-suite[-2][-auto].png.
+# OBJECTS="..." gives every picture these objects instead of its stated ones (ROUTE names
+# them in the ledger, default "objects"; ROOT moves the scenes and solves).
 # Every picture is also a row of results/new-suite.csv (scripts/ledger.sh: set_or_seed
 # "set-NN/seed-S", item the picture, route stated or auto, seconds new + solve).
 set -euo pipefail
@@ -24,13 +26,13 @@ mode=${2:-given}
 cargo build --release --locked --quiet --bin bsa --example contact_sheet
 bsa=$(cargo metadata --format-version 1 --no-deps | python3 -c 'import json,sys; print(json.load(sys.stdin)["target_directory"])')/release
 sheet=$bsa/examples/contact_sheet
-bsa=$bsa/bsa
+bsa=${BSA:-$bsa/bsa}
 set_=${SET:-1}
 pics=tools/test-pictures/set-$(printf %02d "$set_")
 suffix=""
 if [ "$set_" != 1 ]; then suffix=-$set_; fi
 if [ "$mode" = auto ]; then suffix=$suffix-auto; fi
-root=/tmp/bsa-new-suite$suffix
+root=${ROOT:-/tmp/bsa-new-suite$suffix}
 mkdir -p "$root"
 rows=$root/results.tsv
 : >"$rows"
@@ -44,6 +46,7 @@ while IFS=$'\t' read -r name objects options; do
             *) objects=auto:box:0.1397x0.06985x0.0349 ;;
         esac
     fi
+    if [ -n "${OBJECTS:-}" ]; then objects=$OBJECTS; fi
     dir=$root/$name
     rm -rf "$dir" "$dir-out" "$dir-new.log"
     t0=$(date +%s.%N)
@@ -67,6 +70,7 @@ PY
     samples=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["samples"])' "$dir-out/solution.json")
     route=stated
     if [ "$mode" = auto ]; then route=auto; fi
+    if [ -n "${OBJECTS:-}" ]; then route=${ROUTE:-objects}; fi
     ledger_row new-suite "set-$(printf %02d "$set_")/seed-$seed" "$name" "$route" "$final" \
         "$contacts" "$samples" "$wall"
     overlays+=("$dir-out/overlay.png")
@@ -91,4 +95,4 @@ print(f"final IoU: median {statistics.median(ious):.4f}, min {min(ious):.4f}, "
       f"solves with a contact: {sum(r[5] != '0' for r in rows)}; "
       f"start IoU median {statistics.median(float(r[3]) for r in rows):.4f}")
 PY
-"$sheet" "docs/images/new-suite$suffix.png" 4 320 "${overlays[@]}"
+"$sheet" "${SHEET:-docs/images/new-suite$suffix.png}" 4 320 "${overlays[@]}"

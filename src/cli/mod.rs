@@ -441,12 +441,14 @@ struct DesignArgs {
     /// the current folder), `chess:PIECE` (a piece of the built-in chess set: king, queen,
     /// rook, bishop, knight or pawn) and `chess` (one side of it, 16 pieces). Each takes an
     /// optional `*N` count and `/DENSITY` in kg/m^3 (default 705, maple; chess pieces 900,
-    /// boxwood). At most one `auto:` item lets `bsa new` choose how many: `auto:sphere`
-    /// (the radii chosen too), `auto:sphere:R`, `auto:box:XxYxZ`,
-    /// `auto:mesh:FILE.obj[@SCALE]` or `auto:chess` (pieces of one side). Or FILE.json: an
-    /// array of {"kind": "sphere" | "box" | "mesh" | "chess", "radius", "size": [X, Y, Z],
-    /// "obj", "scale", "piece", "count": N | "auto", "density"}, its mesh paths relative
-    /// to its folder. `bsa plant` takes neither `auto:` items nor chess pieces by name
+    /// boxwood). `auto:` items let `bsa new` choose how many, adding objects while one more
+    /// raises the picture's IoU by half a point: `auto:sphere` (the radii chosen too),
+    /// `auto:sphere:R`, `auto:box:XxYxZ`, `auto:mesh:FILE.obj[@SCALE]` or `auto:chess`
+    /// (pieces of one side); several of them make a box of several sizes (each but
+    /// `auto:chess` with an optional `*N`, the most it adds). Or FILE.json: an array of
+    /// {"kind": "sphere" | "box" | "mesh" | "chess", "radius", "size": [X, Y, Z], "obj",
+    /// "scale", "piece", "count": N | "auto", "at_most", "density"}, its mesh paths
+    /// relative to its folder. `bsa plant` takes neither `auto:` items nor chess pieces by name
     /// (give them as meshes: mesh:scenes/thinker/pieces/PIECE.obj).
     #[arg(long, value_name = "LIST|FILE.json")]
     objects: String,

@@ -27,7 +27,7 @@ use crate::design::inventory::{Auto, AutoKind, Inventory, Kind};
 use crate::design::launch::{Geometry, Object, Plan};
 use crate::design::picture::Picture;
 use crate::design::plant::{default_strategy, Stage};
-use crate::design::{self, chess, AutoRequest, DesignError, Request};
+use crate::design::{self, chess, AutoObject, DesignError, Request};
 use crate::energy::Weights;
 use crate::evaluate::Problem;
 use crate::output::files;
@@ -163,9 +163,16 @@ fn mesh_path(dir: &Path, obj: &Path) -> Result<String> {
     )
 }
 
-/// The prototypes of an inventory, the prototype of each item, and the `auto:` kind's
-/// prototypes with how many of each it may add.
-type Prototypes = (Vec<Prototype>, Vec<usize>, Vec<(usize, usize)>);
+/// A kind an `auto:` item may add: its prototype (`None`: spheres of any radius, at the
+/// density), and the most it may add.
+struct AutoSlot {
+    proto: Option<usize>,
+    density: f64,
+    limit: usize,
+}
+
+/// The prototypes of an inventory, the prototype of each item, and the `auto:` kinds.
+type Prototypes = (Vec<Prototype>, Vec<usize>, Vec<AutoSlot>);
 
 /// The prototypes of the inventory: one per distinct item, then those of the `auto:`
 /// kind; and for each item, its prototype.
@@ -182,13 +189,20 @@ fn prototypes(dir: &Path, inv: &Inventory) -> Result<Prototypes> {
             });
         of_item.push(at);
     }
-    // The auto: kind's prototypes and how many of each it may add.
+    // The auto: kinds' prototypes and how many of each they may add.
     let mut auto = Vec::new();
-    if let Some(a) = &inv.auto {
-        let cap = design::AUTO_CAP;
+    for a in &inv.autos {
+        let cap = a.limit.unwrap_or(usize::MAX);
         let kinds: Vec<(Kind, usize)> = match &a.kind {
             AutoKind::Sphere { radius: Some(r) } => vec![(Kind::Sphere { radius: *r }, cap)],
-            AutoKind::Sphere { radius: None } => Vec::new(),
+            AutoKind::Sphere { radius: None } => {
+                auto.push(AutoSlot {
+                    proto: None,
+                    density: a.density,
+                    limit: cap,
+                });
+                continue;
+            }
             AutoKind::Box { size } => vec![(Kind::Box { size: *size }, cap)],
             AutoKind::Mesh { obj, scale } => vec![(
                 Kind::Mesh {
@@ -211,7 +225,11 @@ fn prototypes(dir: &Path, inv: &Inventory) -> Result<Prototypes> {
         };
         for (kind, n) in kinds {
             protos.push((kind, a.density));
-            auto.push((protos.len() - 1, n));
+            auto.push(AutoSlot {
+                proto: Some(protos.len() - 1),
+                density: a.density,
+                limit: n,
+            });
         }
     }
     let protos = protos
@@ -279,7 +297,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         return Err(e);
     }
     check_dark_part(&scene, &protos, &opts.target)?;
-    let request = request_of(&scene, &protos, (&of_item, &auto), &opts.inventory);
+    let request = request_of(&scene, &protos, (&of_item, &auto));
     let (picture, geometry) = picture_and_geometry(&scene);
     // One design per setting, in parallel, each written to its own file beside the
     // scene (mesh paths are relative to the folder) and made contact-free; then, by
@@ -334,13 +352,11 @@ pub(super) fn run(opts: &Options) -> Result<()> {
 }
 
 /// The design's request: the list's fixed items as objects (each its prototype's
-/// shape as the first scene loaded it), and the `auto:` kind's (`auto`: prototype and
-/// count of each).
+/// shape as the first scene loaded it), and the `auto:` kinds.
 fn request_of(
     scene: &Scene,
     protos: &[Prototype],
-    (of_item, auto): (&[usize], &[(usize, usize)]),
-    inventory: &Inventory,
+    (of_item, auto): (&[usize], &[AutoSlot]),
 ) -> Request {
     let objects: Vec<Object> = protos
         .iter()
@@ -354,10 +370,16 @@ fn request_of(
         .collect();
     Request {
         fixed: of_item.iter().map(|&k| objects[k].clone()).collect(),
-        auto: inventory.auto.as_ref().map(|a| match a.kind {
-            AutoKind::Sphere { radius: None } => AutoRequest::Spheres { density: a.density },
-            _ => AutoRequest::Objects(auto.iter().map(|&(k, n)| (objects[k].clone(), n)).collect()),
-        }),
+        auto: auto
+            .iter()
+            .map(|a| {
+                let kind = match a.proto {
+                    Some(k) => AutoObject::Given(objects[k].clone()),
+                    None => AutoObject::Sphere { density: a.density },
+                };
+                (kind, a.limit)
+            })
+            .collect(),
     }
 }
 
@@ -415,7 +437,10 @@ fn tell_written(
         name,
         n,
         if n == 1 { "" } else { "s" },
-        if opts.inventory.auto.is_some() { format!(" ({chosen} chosen by auto:)") } else { String::new() },
+        match plan.auto_stop {
+            Some(why) => format!(" ({chosen} chosen by auto:, which stopped as {why})"),
+            None => String::new(),
+        },
         heights.iter().copied().fold(f64::INFINITY, f64::min),
         heights.iter().copied().fold(0.0, f64::max),
         moves,
@@ -431,11 +456,8 @@ fn tell_written(
     );
     let target = &problem.scene.target;
     let missed = target.and_not_count(&start_picture) as f64 / target.count().max(1) as f64;
-    if let Some(note) = too_few_objects(
-        missed,
-        solved.map_or(start.iou, |s| s.iou),
-        opts.inventory.auto.is_some(),
-    ) {
+    if let Some(note) = too_few_objects(missed, solved.map_or(start.iou, |s| s.iou), plan.auto_stop)
+    {
         eprintln!("{name}: note: {note}");
     }
     Ok(())
@@ -481,15 +503,17 @@ const SHORT_IOU: f64 = 0.9;
 
 /// A note for the user when the box of objects cannot draw the picture: most of what
 /// the start guess misses is target no object's shadow reaches, which no solve can
-/// fill. `None` when the objects suffice.
-fn too_few_objects(missed: f64, iou: f64, auto: bool) -> Option<String> {
+/// fill. `None` when the objects suffice. What helps depends on why an automatic
+/// count stopped (`auto`): at the cap, more objects than it adds; where one more gains
+/// too little, a size that fits the parts left bare.
+fn too_few_objects(missed: f64, iou: f64, auto: Option<design::AutoStop>) -> Option<String> {
     if missed <= BARE_SHARE || iou >= SHORT_IOU {
         return None;
     }
-    let advice = if auto {
-        "objects shaped more like its parts"
-    } else {
-        "more objects, or objects shaped more like its parts (auto:box:XxYxZ, auto:sphere or auto:chess lets bsa new choose how many)"
+    let advice = match auto {
+        None => "more objects, or objects shaped more like its parts (auto:box:XxYxZ, auto:sphere or auto:chess lets bsa new choose how many, and several auto:box items which sizes)",
+        Some(design::AutoStop::Cap) => "more objects than auto: adds (it stops at its cap): list the objects with their counts, or add larger ones",
+        Some(_) => "objects of a size that fits its bare parts (another auto: item of a smaller size)",
     };
     Some(format!(
         "the objects leave {:.0} % of the picture bare at the start, and the design reaches IoU {iou:.3}; the picture may need {advice}",
@@ -668,20 +692,6 @@ fn check_dark_part(scene: &Scene, protos: &[Prototype], target: &Path) -> Result
     }
 }
 
-/// An `auto:` item as the user's list names it.
-fn describe_auto(auto: &Auto) -> String {
-    match &auto.kind {
-        AutoKind::Sphere { radius: None } => "auto:sphere".to_string(),
-        AutoKind::Sphere { radius: Some(r) } => format!("auto:sphere:{r}"),
-        AutoKind::Box { size } => format!("auto:box:{}x{}x{}", size[0], size[1], size[2]),
-        AutoKind::Mesh { obj, scale } if *scale != 1.0 => {
-            format!("auto:mesh:{}@{scale}", obj.display())
-        }
-        AutoKind::Mesh { obj, .. } => format!("auto:mesh:{}", obj.display()),
-        AutoKind::Chess => "auto:chess".to_string(),
-    }
-}
-
 /// A design's error told in terms of the command's inputs: which `--objects` item, on
 /// which `--target`, and what to change.
 fn design_in_users_terms(
@@ -701,14 +711,11 @@ fn design_in_users_terms(
     );
     match err.downcast_ref::<DesignError>() {
         Some(DesignError::NothingWorthIt) => {
-            let auto = opts
-                .inventory
-                .auto
-                .as_ref()
-                .map_or("auto:".to_string(), describe_auto);
+            let auto: Vec<String> = opts.inventory.autos.iter().map(Auto::to_string).collect();
+            let auto = auto.join(",");
             anyhow::anyhow!(
-                "--objects {auto}: on {picture} no such object is worth launching: wherever its shadow falls it would cover less than {:.0} % of its own area with dark pixels not yet covered; use smaller objects (auto:sphere chooses their size), or a wider picture (--width) so that the picture's strokes are wider against them",
-                design::AUTO_MIN_SHARE * 100.0
+                "--objects {auto}: on {picture} no such object is worth launching: wherever its shadow falls it would raise the picture's IoU by less than {}; use smaller objects (auto:sphere chooses their size), or a wider picture (--width) so that the picture's strokes are wider against them",
+                design::AUTO_MIN_RISE
             )
         }
         Some(DesignError::NoRoom { index, .. }) => {

@@ -31,7 +31,7 @@ pub(super) struct Options {
 impl Options {
     pub(super) fn new(args: PlantArgs) -> Result<Options> {
         let design = Design::new(args.design)?;
-        if design.inventory.auto.is_some() {
+        if !design.inventory.autos.is_empty() {
             bail!("--objects: bsa plant draws a fixed box of objects; auto: items are for bsa new");
         }
         Ok(Options {

@@ -1,9 +1,11 @@
 //! A box of objects, as a user lists them. [`parse`] reads the command-line list:
 //! comma-separated items `sphere:R`, `box:XxYxZ`, `mesh:FILE.obj[@SCALE]`, `chess:PIECE`
 //! (a piece of the built-in chess set) or `chess` (one side: 16 pieces), each with an
-//! optional `*N` count and `/DENSITY` (metres, kg/m^3); and at most one item that lets
-//! the design choose the count: `auto:sphere` (radii chosen too), `auto:sphere:R`,
-//! `auto:box:XxYxZ`, `auto:mesh:FILE.obj[@SCALE]`, `auto:chess` (pieces of one side).
+//! optional `*N` count and `/DENSITY` (metres, kg/m^3); and items that let the design
+//! choose the count: `auto:sphere` (radii chosen too), `auto:sphere:R`,
+//! `auto:box:XxYxZ`, `auto:mesh:FILE.obj[@SCALE]`, `auto:chess` (pieces of one side),
+//! each but `auto:chess` with an optional `*N`, the most it may add (a box of blocks
+//! of three sizes is three `auto:box` items).
 //! [`parse_json`] reads the same from a JSON file. Errors name the item (or the
 //! JSON entry and field) and say why. A mesh's file must exist when the list is read:
 //! its path is taken as given (relative to the current folder, or to a JSON list's
@@ -80,13 +82,35 @@ pub enum AutoKind {
 pub struct Auto {
     pub kind: AutoKind,
     pub density: f64,
+    /// The most the design may add of it (`*N`); `None`: as many as pay.
+    pub limit: Option<usize>,
 }
 
-/// A parsed list: the objects given, and at most one kind whose count is chosen.
+/// An `auto:` item as the user's list names it.
+impl std::fmt::Display for Auto {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.kind {
+            AutoKind::Sphere { radius: None } => write!(f, "auto:sphere")?,
+            AutoKind::Sphere { radius: Some(r) } => write!(f, "auto:sphere:{r}")?,
+            AutoKind::Box { size } => write!(f, "auto:box:{}x{}x{}", size[0], size[1], size[2])?,
+            AutoKind::Mesh { obj, scale } if *scale != 1.0 => {
+                write!(f, "auto:mesh:{}@{scale}", obj.display())?
+            }
+            AutoKind::Mesh { obj, .. } => write!(f, "auto:mesh:{}", obj.display())?,
+            AutoKind::Chess => write!(f, "auto:chess")?,
+        }
+        match self.limit {
+            Some(n) => write!(f, "*{n}"),
+            None => Ok(()),
+        }
+    }
+}
+
+/// A parsed list: the objects given, and the kinds whose counts are chosen.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Inventory {
     pub items: Vec<Item>,
-    pub auto: Option<Auto>,
+    pub autos: Vec<Auto>,
 }
 
 /// Why a list cannot be read.
@@ -119,16 +143,13 @@ pub enum InventoryError {
     /// More objects than [`MAX_OBJECTS`].
     #[error("the object list asks for {count} objects; at most {MAX_OBJECTS}")]
     TooMany { count: usize },
-    /// More than one `auto:` item.
-    #[error("at most one auto: item may choose its count (items {first} and {second} both do)")]
-    TwoAutos { first: usize, second: usize },
 }
 
-/// A count: given, or chosen by the design.
+/// A count: given, or chosen by the design up to a limit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Count {
     Fixed(usize),
-    Auto,
+    Auto(Option<usize>),
 }
 
 /// One entry before validation, as either syntax gives it.
@@ -226,17 +247,21 @@ impl Spec {
         }
     }
 
-    /// The count: chosen by the design for an `auto:` item (which may give none), else
-    /// given (at least 1) or 1.
+    /// The count: chosen by the design for an `auto:` item, at most its `*N` if given
+    /// (at least 1; `auto:chess` takes a side's numbers), else given (at least 1) or 1.
     fn count(&self) -> Result<Count, Refusal> {
         if self.auto {
-            if self.count.is_some() {
-                return Err(refuse(
+            return match self.count {
+                Some(_) if self.kind == "chess" => Err(refuse(
                     "count",
-                    "an auto: item chooses its own count; drop *N",
-                ));
-            }
-            return Ok(Count::Auto);
+                    "auto:chess adds at most a side's pieces of each kind; drop *N",
+                )),
+                Some(0) => Err(refuse(
+                    "count",
+                    "the most an auto: item adds must be at least 1",
+                )),
+                limit => Ok(Count::Auto(limit)),
+            };
         }
         match self.count {
             Some(0) => Err(refuse("count", "count must be at least 1")),
@@ -337,31 +362,19 @@ impl Spec {
 }
 
 /// Add `spec`'s objects to `inv`; `Err((field, reason))` names the field at fault.
-fn add(
-    spec: Spec,
-    inv: &mut Inventory,
-    auto_at: &mut Option<usize>,
-    index: usize,
-    look: Look,
-) -> Result<(), Refusal> {
+fn add(spec: Spec, inv: &mut Inventory, look: Look) -> Result<(), Refusal> {
     let density = spec.density()?;
     let count = spec.count()?;
     let scale = spec.scale()?;
     let n = match count {
         Count::Fixed(n) => n,
-        Count::Auto => {
-            if let Some(first) = *auto_at {
-                return Err(refuse(
-                    "auto",
-                    InventoryError::TwoAutos {
-                        first,
-                        second: index,
-                    },
-                ));
-            }
-            *auto_at = Some(index);
+        Count::Auto(limit) => {
             let kind = spec.auto_kind(scale, look)?;
-            inv.auto = Some(Auto { kind, density });
+            inv.autos.push(Auto {
+                kind,
+                density,
+                limit,
+            });
             return Ok(());
         }
     };
@@ -428,12 +441,11 @@ fn bad_count(n: &str) -> String {
 pub fn parse(list: &str, look: Look) -> Result<Inventory, InventoryError> {
     let mut inv = Inventory {
         items: Vec::new(),
-        auto: None,
+        autos: Vec::new(),
     };
     if list.trim().is_empty() {
         return Err(InventoryError::Empty);
     }
-    let mut auto_at = None;
     for (k, raw) in list.split(',').map(str::trim).enumerate() {
         let index = k + 1;
         // An empty item is most likely a slip (an object deleted from the middle of
@@ -514,9 +526,9 @@ pub fn parse(list: &str, look: Look) -> Result<Inventory, InventoryError> {
                 })
             }
         }
-        add(spec, &mut inv, &mut auto_at, index, look).map_err(|(_, reason)| bad(reason))?;
+        add(spec, &mut inv, look).map_err(|(_, reason)| bad(reason))?;
     }
-    if inv.items.is_empty() && inv.auto.is_none() {
+    if inv.items.is_empty() && inv.autos.is_empty() {
         return Err(InventoryError::Empty);
     }
     Ok(inv)
@@ -524,7 +536,8 @@ pub fn parse(list: &str, look: Look) -> Result<Inventory, InventoryError> {
 
 /// Parse a JSON object list: an array (or `{"objects": [...]}`) of entries
 /// `{"kind": "sphere" | "box" | "mesh" | "chess", "radius": R, "size": [X, Y, Z],
-/// "obj": FILE, "scale": S, "piece": NAME, "count": N | "auto", "density": D}` with the
+/// "obj": FILE, "scale": S, "piece": NAME, "count": N | "auto", "at_most": N (the most
+/// an "auto" entry adds), "density": D}` with the
 /// fields of their kind. Mesh paths are relative to `base` (the file's folder); `look`
 /// tells what one names.
 pub fn parse_json(text: &str, base: &Path, look: Look) -> Result<Inventory, InventoryError> {
@@ -533,15 +546,14 @@ pub fn parse_json(text: &str, base: &Path, look: Look) -> Result<Inventory, Inve
     let list = json_entries(&v)?;
     let mut inv = Inventory {
         items: Vec::new(),
-        auto: None,
+        autos: Vec::new(),
     };
-    let mut auto_at = None;
     for (i, e) in list.iter().enumerate() {
         let spec = json_spec(i, e, base)?;
         let at = |f: &str| format!("objects[{i}].{f}");
-        add(spec, &mut inv, &mut auto_at, i + 1, look).map_err(|(f, r)| json(at(&f), r))?;
+        add(spec, &mut inv, look).map_err(|(f, r)| json(at(&f), r))?;
     }
-    if inv.items.is_empty() && inv.auto.is_none() {
+    if inv.items.is_empty() && inv.autos.is_empty() {
         return Err(InventoryError::Empty);
     }
     Ok(inv)
@@ -610,7 +622,7 @@ fn json_spec(i: usize, e: &Value, base: &Path) -> Result<Spec, InventoryError> {
     };
     for key in o.keys() {
         if ![
-            "kind", "radius", "size", "obj", "scale", "piece", "count", "density",
+            "kind", "radius", "size", "obj", "scale", "piece", "count", "at_most", "density",
         ]
         .contains(&key.as_str())
         {
@@ -631,7 +643,26 @@ fn json_spec(i: usize, e: &Value, base: &Path) -> Result<Spec, InventoryError> {
             ))
         }
     };
-    let (auto, count) = json_count(o.get("count")).map_err(|r| json(at("count"), r))?;
+    let (auto, mut count) = json_count(o.get("count")).map_err(|r| json(at("count"), r))?;
+    if let Some(limit) = o.get("at_most") {
+        if !auto {
+            return Err(json(
+                at("at_most"),
+                "only an entry with \"count\": \"auto\" takes at_most".into(),
+            ));
+        }
+        count = Some(
+            limit
+                .as_u64()
+                .map(|n| usize::try_from(n).unwrap_or(usize::MAX))
+                .ok_or_else(|| {
+                    json(
+                        at("at_most"),
+                        format!("expected a whole number, got {limit}"),
+                    )
+                })?,
+        );
+    }
     Ok(Spec {
         kind,
         radius: num("radius")?,
@@ -701,7 +732,7 @@ mod tests {
                 scale: 2.0
             }
         );
-        assert!(inv.auto.is_none());
+        assert!(inv.autos.is_empty());
     }
 
     #[test]
@@ -723,26 +754,36 @@ mod tests {
         let inv = parse("chess:king,auto:box:0.14x0.07x0.035/650", LOOK).unwrap();
         assert_eq!(inv.items.len(), 1);
         assert_eq!(
-            inv.auto,
-            Some(Auto {
+            inv.autos,
+            [Auto {
                 kind: AutoKind::Box {
                     size: [0.14, 0.07, 0.035]
                 },
-                density: 650.0
-            })
+                density: 650.0,
+                limit: None,
+            }]
         );
         assert_eq!(
-            parse("auto:sphere", LOOK).unwrap().auto.unwrap().kind,
+            parse("auto:sphere", LOOK).unwrap().autos[0].kind,
             AutoKind::Sphere { radius: None }
         );
         assert_eq!(
-            parse("auto:sphere:0.2", LOOK).unwrap().auto.unwrap().kind,
+            parse("auto:sphere:0.2", LOOK).unwrap().autos[0].kind,
             AutoKind::Sphere { radius: Some(0.2) }
         );
         assert_eq!(
-            parse("auto:chess", LOOK).unwrap().auto.unwrap().kind,
+            parse("auto:chess", LOOK).unwrap().autos[0].kind,
             AutoKind::Chess
         );
+        // A box of blocks of three sizes, the smallest at most four.
+        let inv = parse(
+            "auto:box:0.28x0.07x0.035,auto:box:0.14x0.07x0.035,auto:box:0.07x0.07x0.035*4",
+            LOOK,
+        )
+        .unwrap();
+        let limits: Vec<Option<usize>> = inv.autos.iter().map(|a| a.limit).collect();
+        assert_eq!(limits, [None, None, Some(4)]);
+        assert_eq!(inv.autos[2].to_string(), "auto:box:0.07x0.07x0.035*4");
     }
 
     #[test]
@@ -750,7 +791,7 @@ mod tests {
         let text = r#"{"objects": [
             {"kind": "box", "size": [0.14, 0.07, 0.035], "count": 2, "density": 600},
             {"kind": "mesh", "obj": "pawn.obj", "scale": 2},
-            {"kind": "sphere", "count": "auto"}]}"#;
+            {"kind": "sphere", "count": "auto", "at_most": 5}]}"#;
         let inv = parse_json(text, Path::new("scenes/thinker/pieces"), LOOK).unwrap();
         assert_eq!(inv.items.len(), 3);
         assert_eq!(
@@ -764,7 +805,14 @@ mod tests {
                 scale: 2.0
             }
         );
-        assert_eq!(inv.auto.unwrap().kind, AutoKind::Sphere { radius: None });
+        assert_eq!(
+            inv.autos,
+            [Auto {
+                kind: AutoKind::Sphere { radius: None },
+                density: DEFAULT_DENSITY,
+                limit: Some(5)
+            }]
+        );
     }
 
     #[test]
@@ -778,8 +826,8 @@ mod tests {
             ("sphere:0.1*1000", "at most 64"),
             ("sphere:abc", "not a number"),
             ("chess:emperor", "unknown chess piece `emperor`"),
-            ("auto:box:0.1x0.1x0.1*3", "drop *N"),
-            ("auto:sphere,auto:chess", "at most one auto"),
+            ("auto:chess*3", "drop *N"),
+            ("auto:box:0.1x0.1x0.1*0", "must be at least 1"),
             ("sphere", "expected kind:size"),
             ("sphere:0.1,,sphere:0.1", "item 2 is empty"),
             ("sphere:0.1,", "item 2 is empty"),
@@ -815,6 +863,10 @@ mod tests {
             (
                 "[{\"kind\": \"box\", \"size\": [1, 1, 1], \"count\": \"many\"}]",
                 "objects[0].count",
+            ),
+            (
+                "[{\"kind\": \"sphere\", \"radius\": 0.1, \"at_most\": 2}]",
+                "objects[0].at_most: only an entry with",
             ),
             ("{\"things\": []}", "things: unknown key"),
             ("{\"objects\": 1}", "objects: expected an array"),

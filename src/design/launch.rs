@@ -82,6 +82,8 @@ pub struct Plan {
     pub geometry: Geometry,
     pub objects: Vec<Planned>,
     pub slots: Vec<DVec2>,
+    /// Why the `auto:` kinds' count stopped, when there are any.
+    pub auto_stop: Option<super::AutoStop>,
 }
 
 /// The launch of one planned object: pose on the table and start velocities.
@@ -121,6 +123,7 @@ impl Plan {
             geometry,
             objects: planned,
             slots: Vec::new(),
+            auto_stop: None,
         };
         plan.slots = plan.slot_grid();
         let targets: Vec<DVec2> = (0..plan.objects.len())

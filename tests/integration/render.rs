@@ -279,7 +279,7 @@ fn new_refuses_pictures_objects_and_options_it_cannot_use() {
             "/nonexistent/piece.obj",
         ),
         (m, "chess:emperor", vec![], "unknown chess piece `emperor`"),
-        (m, "auto:sphere,auto:chess", vec![], "at most one auto"),
+        (m, "auto:chess*3", vec![], "drop *N"),
         (m, "sphere:0.1", vec!["--t", "0"], "--t"),
         (
             m,
@@ -367,7 +367,8 @@ fn new_reads_a_json_list_chess_pieces_and_chooses_a_count() {
     let list = d.join("objects.json");
     std::fs::write(
         &list,
-        r#"[{"kind": "chess", "piece": "pawn", "count": 2}, {"kind": "box", "size": [0.05, 0.02, 0.02], "count": "auto"}]"#,
+        r#"[{"kind": "chess", "piece": "pawn", "count": 2}, {"kind": "box", "size": [0.05, 0.02, 0.02], "count": "auto"},
+            {"kind": "box", "size": [0.02, 0.02, 0.02], "count": "auto", "at_most": 1}]"#,
     )
     .unwrap();
     let dir = d.join("j");
@@ -395,7 +396,20 @@ fn new_reads_a_json_list_chess_pieces_and_chooses_a_count() {
         .and_then(|s| s.split(' ').next())
         .and_then(|s| s.parse().ok())
         .unwrap_or_else(|| panic!("{out}"));
-    assert!(chosen >= 1, "{out}");
+    assert!(
+        chosen >= 1 && out.contains("chosen by auto:, which stopped as"),
+        "{out}"
+    );
+    // At most one cube, as the list says.
+    let scene: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
+    let cubes = scene["occluders"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|o| o["shape"]["box"]["size"] == serde_json::json!([0.02, 0.02, 0.02]))
+        .count();
+    assert!(cubes <= 1, "{cubes} cubes");
     // A JSON list's errors name the entry and the field.
     std::fs::write(&list, r#"[{"kind": "box", "size": [0.1, 0.1]}]"#).unwrap();
     let (ok, _, err) = run(args(list.to_str().unwrap()));

@@ -115,7 +115,7 @@ pub struct Cover<'a> {
     picture: &'a Picture,
     frame: Frame,
     /// +1 target not yet covered, -1 background not yet covered, 0 covered.
-    value: Vec<f32>,
+    pub(super) value: Vec<f32>,
     /// Bit k: placement k's shadow is on (or near) this pixel.
     owners: Vec<u64>,
     /// Bit k: placement k's shadow is on this pixel (so that one placement can be lifted
@@ -182,6 +182,17 @@ impl<'a> Cover<'a> {
     /// Target pixels not yet covered.
     pub fn open(&self) -> usize {
         self.value.iter().filter(|&&v| v > 0.0).count()
+    }
+
+    /// Pixels of the target or of a shadow: the union of the design's IoU.
+    pub fn union(&self) -> usize {
+        let covered_background = self
+            .value
+            .iter()
+            .zip(&self.picture.on)
+            .filter(|&(&v, &on)| v == 0.0 && !on)
+            .count();
+        self.picture.count() + covered_background
     }
 
     /// The uncovered target as a picture.
