@@ -57,7 +57,7 @@ while IFS=$'\t' read -r name objects options; do
     "$bsa" solve "$dir" -q --seed "$seed" --out "$dir-out" >"$dir-out.log"
     t1=$(date +%s.%N)
     start=$(sed -n 's/.*start guess IoU \([0-9.]*\).*/\1/p' <<<"$new")
-    count=$(sed -n 's/^[^:]*: \([0-9]*\) objects.*/\1/p' <<<"$new")
+    count=$(sed -n 's/^[^:]*: \([0-9]*\) objects\{0,1\} .*/\1/p' <<<"$new")
     python3 - "$dir-out/solution.json" "$name" "$objects" "$count" "$start" "$t0" "$t1" >>"$rows" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))

@@ -400,34 +400,42 @@ fn table_new_suite() -> String {
     t
 }
 
-/// The last set of the `bsa new` suite picture by picture, its stated objects beside
-/// `auto:`.
+/// The last set of the `bsa new` suite picture by picture: a column of IoU and wall
+/// time for each run of it (objects and commit), in the ledger's order.
 fn table_new_suite_latest() -> String {
     let rows = ledger("new-suite");
     let Some(latest) = rows.last() else {
         return String::new();
     };
     let set = latest.set_or_seed.clone();
-    let mine: Vec<&Row> = rows.iter().filter(|r| r.set_or_seed == set).collect();
-    let mut t = format!(
-        "| {set}: picture | stated objects: IoU | wall time | `auto:`: IoU | wall time |\n|---|---|---|---|---|\n"
-    );
-    let find = |item: &str, route: &str| {
-        mine.iter()
-            .rev()
-            .find(|r| r.item == item && r.route == route)
-            .copied()
-    };
-    for item in items(&mine.iter().map(|r| (*r).clone()).collect::<Vec<_>>()) {
-        let (s, a) = (find(&item, "stated"), find(&item, "auto"));
-        let _ = writeln!(
-            t,
-            "| {item} | {} | {} | {} | {} |",
-            iou(s.and_then(|r| r.iou)),
-            secs(s.and_then(|r| r.seconds)),
-            iou(a.and_then(|r| r.iou)),
-            secs(a.and_then(|r| r.seconds))
-        );
+    let mine: Vec<Row> = rows
+        .iter()
+        .filter(|r| r.set_or_seed == set)
+        .cloned()
+        .collect();
+    let runs: Vec<(String, String, String)> = last_runs(&mine, usize::MAX);
+    let mut t = format!("| {set}: picture |");
+    for (commit, _, route) in &runs {
+        let _ = write!(t, " {route} at {commit}: IoU | wall time |");
+    }
+    t.push_str("\n|---|");
+    t.push_str(&"---|---|".repeat(runs.len()));
+    t.push('\n');
+    for item in items(&mine) {
+        let _ = write!(t, "| {item} |");
+        for (commit, _, route) in &runs {
+            let r = mine
+                .iter()
+                .rev()
+                .find(|r| r.item == item && &r.route == route && &r.commit == commit);
+            let _ = write!(
+                t,
+                " {} | {} |",
+                iou(r.and_then(|r| r.iou)),
+                secs(r.and_then(|r| r.seconds))
+            );
+        }
+        t.push('\n');
     }
     t
 }
