@@ -144,17 +144,9 @@ struct Terms {
 
 /// The terms as one JSON object (`--json`).
 fn print_json(scene: &Scene, terms: &Terms) -> Result<()> {
-    let Terms {
-        stage: k,
-        rows,
-        total,
-        evaluation: e,
-        first_contact,
-        outside,
-        frame_ious,
-        timings,
-    } = terms;
-    let terms: serde_json::Map<String, serde_json::Value> = rows
+    let e = &terms.evaluation;
+    let rows: serde_json::Map<String, serde_json::Value> = terms
+        .rows
         .iter()
         .map(|(t, raw, w, wt)| {
             (
@@ -165,18 +157,19 @@ fn print_json(scene: &Scene, terms: &Terms) -> Result<()> {
         .collect();
     let mut v = serde_json::json!({
         "scene": scene.name,
-        "stage": k,
-        "terms": terms,
-        "total": total,
+        "stage": terms.stage,
+        "terms": rows,
+        "total": terms.total,
         "iou": e.iou,
         "t_sim": e.outcome.t_sim,
         "n_contacts": e.outcome.n_contacts,
-        "first_contact": first_contact.as_ref().map(|(a, b)| [a, b]),
-        "shadows_outside_image": outside,
-        "time_per_phase_us": timings.iter().map(|(k, v)| (k.clone(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
+        "first_contact": terms.first_contact.as_ref().map(|(a, b)| [a, b]),
+        "shadows_outside_image": terms.outside,
+        "time_per_phase_us": terms.timings.iter().map(|(k, v)| (k.clone(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
     });
-    if !frame_ious.is_empty() {
-        v["frames"] = frame_ious
+    if !terms.frame_ious.is_empty() {
+        v["frames"] = terms
+            .frame_ious
             .iter()
             .map(|f| serde_json::json!({"t_s": f.t, "picture": f.picture + 1, "iou": f.iou}))
             .collect();

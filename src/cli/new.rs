@@ -192,24 +192,25 @@ fn prototypes(dir: &Path, inv: &Inventory) -> Result<Prototypes> {
     // The auto: kinds' prototypes and how many of each they may add.
     let mut auto = Vec::new();
     for a in &inv.autos {
-        let cap = a.limit.unwrap_or(usize::MAX);
+        // The design's own cap bounds an item without `*N`.
+        let limit = a.limit.unwrap_or(usize::MAX);
         let kinds: Vec<(Kind, usize)> = match &a.kind {
-            AutoKind::Sphere { radius: Some(r) } => vec![(Kind::Sphere { radius: *r }, cap)],
+            AutoKind::Sphere { radius: Some(r) } => vec![(Kind::Sphere { radius: *r }, limit)],
             AutoKind::Sphere { radius: None } => {
                 auto.push(AutoSlot {
                     proto: None,
                     density: a.density,
-                    limit: cap,
+                    limit,
                 });
                 continue;
             }
-            AutoKind::Box { size } => vec![(Kind::Box { size: *size }, cap)],
+            AutoKind::Box { size } => vec![(Kind::Box { size: *size }, limit)],
             AutoKind::Mesh { obj, scale } => vec![(
                 Kind::Mesh {
                     obj: obj.clone(),
                     scale: *scale,
                 },
-                cap,
+                limit,
             )],
             AutoKind::Chess => chess::PIECES
                 .iter()

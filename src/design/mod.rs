@@ -312,8 +312,9 @@ fn add_auto(
         }
         let union = cover.union() as f64;
         // No placement gains more than the target left open.
-        if (cover.open() as f64) < AUTO_MIN_RISE * union {
-            return AutoStop::Rise(Some(cover.open() as f64 / union));
+        let open = cover.open() as f64;
+        if open < AUTO_MIN_RISE * union {
+            return AutoStop::Rise(Some(open / union));
         }
         let k = objects.len();
         let mut best: Option<(Placement, Object, usize)> = None;
