@@ -7,6 +7,8 @@ use super::*;
 /// A solution's launch with its drag model.
 pub struct Budget<'a> {
     pub problem: &'a Problem,
+    /// Whether the bodies fly through air (else the exact parabola, as the solver's).
+    pub air: bool,
     pub drag: DragConfig,
     /// Drag coefficients of every occluder.
     pub bodies: Vec<BodyDrag>,
@@ -34,8 +36,8 @@ pub struct BudgetWorkspace {
     /// alone most bodies' other half does not change from sample to sample (a speed
     /// error leaves the spin, a spin error the drag flight), and a match gives the same
     /// bits as computing again.
-    last_com: Vec<Option<([u64; 8], DVec3)>>,
-    last_q: Vec<Option<([u64; 4], DQuat)>>,
+    last_com: Vec<Option<([u64; 11], DVec3)>>,
+    last_q: Vec<Option<([u64; 8], DQuat)>>,
     /// The drag flights a sample still has to fly, their bodies and results.
     flights: Vec<drag::Flight>,
     flown: Vec<usize>,
@@ -127,6 +129,7 @@ impl<'a> Budget<'a> {
         let vacuum_iou = energy::iou(&ws.mask, &problem.target.mask);
         Ok(Budget {
             problem,
+            air: true,
             drag,
             bodies,
             vacuum: params.to_vec(),
@@ -134,6 +137,15 @@ impl<'a> Budget<'a> {
             vacuum_com,
             landed,
             vacuum_iou,
+        })
+    }
+
+    /// The budget of launch values `params` flown in a vacuum, as the solver flies them:
+    /// the launcher's errors alone.
+    pub fn vacuum(problem: &'a Problem, params: &[f64]) -> Result<Budget<'a>, BudgetError> {
+        Ok(Budget {
+            air: false,
+            ..Budget::new(problem, params, DragConfig::default())?
         })
     }
 
@@ -160,22 +172,32 @@ impl<'a> Budget<'a> {
         e: &BodyError,
         flight: Option<&mut FreeFlight>,
     ) -> (DVec3, DQuat) {
-        let Some((v, w, tau)) = self.perturbed(v, w, e) else {
+        let Some((s, tau)) = self.perturbed(i, v, w, e) else {
             return (DVec3::NAN, DQuat::NAN);
         };
-        let com = self.drag_com_of(i, v, w, e.cd, tau);
-        let q = flight.map_or(DQuat::IDENTITY, |f| self.orientation_of(i, w, tau, f));
+        let com = self.drag_com_of(i, &s, e.cd, tau);
+        let q = flight.map_or(DQuat::IDENTITY, |f| self.orientation_of(i, &s, tau, f));
         (com, q)
     }
 
-    /// The launch velocity, spin and flight time of a launch `v`, `w` with errors `e`;
-    /// `None` for a launch no flight can follow.
-    fn perturbed(&self, v: DVec3, w: DVec3, e: &BodyError) -> Option<(DVec3, DVec3, f64)> {
+    /// The launch occluder `i` gets when asked for `v`, `w` with errors `e`, and its
+    /// flight time; `None` for a launch no flight can follow.
+    fn perturbed(&self, i: usize, v: DVec3, w: DVec3, e: &BodyError) -> Option<(LaunchState, f64)> {
         let scene = &self.problem.scene;
-        let v = aim(v, e.direction) * (1.0 + e.speed);
-        let w = w * (1.0 + e.spin);
+        let asked = Launch {
+            velocity: v,
+            angular_velocity: w,
+        };
+        let s = e.apply(LaunchState::of(&scene.occluders[i], asked));
         let tau = scene.t - e.timing;
-        (v.is_finite() && w.is_finite() && w.length() * scene.t <= MAX_TURN).then_some((v, w, tau))
+        let w = s.angular_velocity;
+        (s.velocity.is_finite() && w.is_finite() && w.length() * scene.t <= MAX_TURN)
+            .then_some((s, tau))
+    }
+
+    /// Occluder `i`'s centre of mass at launch `s`.
+    fn launch_com(&self, i: usize, s: &LaunchState) -> DVec3 {
+        s.origin + s.orientation * self.problem.scene.occluders[i].mass.local_com
     }
 
     /// Occluder `i`'s drag model with its drag coefficient off by the factor
@@ -190,7 +212,7 @@ impl<'a> Budget<'a> {
 
     /// Fly the drag flights queued in `bws` together and keep their centres of mass in
     /// its memo under `keys`.
-    fn fly_batch(&self, bws: &mut BudgetWorkspace, keys: &[[u64; 8]; MAX_BATCH]) {
+    fn fly_batch(&self, bws: &mut BudgetWorkspace, keys: &[[u64; 11]; MAX_BATCH]) {
         bws.flown_to.clear();
         bws.flown_to
             .resize(bws.flights.len(), (DVec3::ZERO, DVec3::ZERO));
@@ -208,16 +230,19 @@ impl<'a> Budget<'a> {
         bws.flown.clear();
     }
 
-    /// Centre of mass with drag of occluder `i` after `tau` from launch `v`, `w`, its
-    /// drag coefficient off by the factor `1 + cd_error`.
-    fn drag_com_of(&self, i: usize, v: DVec3, w: DVec3, cd_error: f64, tau: f64) -> DVec3 {
+    /// Centre of mass with drag of occluder `i` after `tau` from launch `s`, its drag
+    /// coefficient off by the factor `1 + cd_error`.
+    fn drag_com_of(&self, i: usize, s: &LaunchState, cd_error: f64, tau: f64) -> DVec3 {
         let scene = &self.problem.scene;
+        if !self.air {
+            return self.launch_com(i, s) + s.velocity * tau + scene.gravity * (0.5 * tau * tau);
+        }
         let body = self.body_with_cd(i, cd_error);
         drag::fly(
             &body,
-            scene.occluders[i].launch_com(),
-            v,
-            w,
+            self.launch_com(i, s),
+            s.velocity,
+            s.angular_velocity,
             scene.gravity,
             tau,
             self.drag.max_step,
@@ -225,20 +250,17 @@ impl<'a> Budget<'a> {
         .0
     }
 
-    /// Orientation of occluder `i` after `tau` from launch spin `w` (drag exerts no
-    /// torque in the model, so it is the torque-free one).
-    fn orientation_of(&self, i: usize, w: DVec3, tau: f64, f: &mut FreeFlight) -> DQuat {
+    /// Orientation of occluder `i` after `tau` from launch `s` (drag exerts no torque in
+    /// the model, so it is the torque-free one).
+    fn orientation_of(&self, i: usize, s: &LaunchState, tau: f64, f: &mut FreeFlight) -> DQuat {
         let scene = &self.problem.scene;
         let o = &scene.occluders[i];
         f.reset(
             &o.mass,
-            LaunchState::of(
-                o,
-                Launch {
-                    velocity: DVec3::ZERO,
-                    angular_velocity: w,
-                },
-            ),
+            LaunchState {
+                velocity: DVec3::ZERO,
+                ..*s
+            },
             scene.gravity,
             tau.max(scene.t),
             &self.problem.flight,
@@ -261,7 +283,7 @@ impl<'a> Budget<'a> {
         // orientations; then the poses.
         bws.flights.clear();
         bws.flown.clear();
-        let mut keys = [[0u64; 8]; MAX_BATCH];
+        let mut keys = [[0u64; 11]; MAX_BATCH];
         for (i, o) in scene.occluders.iter().enumerate() {
             if !o.launched {
                 continue;
@@ -271,16 +293,17 @@ impl<'a> Budget<'a> {
                 angular_velocity: w,
             } = Launch::get(params, i);
             let e = &errors[i];
-            let Some((v, w, tau)) = self.perturbed(v, w, e) else {
+            let Some((s, tau)) = self.perturbed(i, v, w, e) else {
                 return (0.0, true);
             };
+            let (v, w, com0) = (s.velocity, s.angular_velocity, self.launch_com(i, &s));
             // The drag flight reads the spin only through the Magnus lift.
             let wb = if self.bodies[i].magnus_radius.is_some() {
                 bits(w)
             } else {
                 [0; 3]
             };
-            let vb = bits(v);
+            let (vb, cb) = (bits(v), bits(com0));
             let key = [
                 vb[0],
                 vb[1],
@@ -290,8 +313,13 @@ impl<'a> Budget<'a> {
                 wb[2],
                 tau.to_bits(),
                 e.cd.to_bits(),
+                cb[0],
+                cb[1],
+                cb[2],
             ];
-            if bws.last_com[i].is_none_or(|(k, _)| k != key) {
+            if !self.air {
+                bws.last_com[i] = Some((key, self.drag_com_of(i, &s, e.cd, tau)));
+            } else if bws.last_com[i].is_none_or(|(k, _)| k != key) {
                 if bws.flown.len() == MAX_BATCH {
                     self.fly_batch(bws, &keys);
                 }
@@ -299,16 +327,25 @@ impl<'a> Budget<'a> {
                 bws.flown.push(i);
                 bws.flights.push(drag::Flight {
                     body: self.body_with_cd(i, e.cd),
-                    x0: o.launch_com(),
+                    x0: com0,
                     v0: v,
                     w,
                     duration: tau,
                 });
             }
-            let wb = bits(w);
-            let q_key = [wb[0], wb[1], wb[2], tau.to_bits()];
+            let (wb, qb) = (bits(w), s.orientation.to_array().map(f64::to_bits));
+            let q_key = [
+                wb[0],
+                wb[1],
+                wb[2],
+                tau.to_bits(),
+                qb[0],
+                qb[1],
+                qb[2],
+                qb[3],
+            ];
             if bws.last_q[i].is_none_or(|(k, _)| k != q_key) {
-                let q = self.orientation_of(i, w, tau, &mut bws.flight);
+                let q = self.orientation_of(i, &s, tau, &mut bws.flight);
                 bws.last_q[i] = Some((q_key, q));
             }
         }
@@ -449,7 +486,7 @@ impl<'a> Budget<'a> {
         pool: &rayon::ThreadPool,
         progress: &dyn Progress,
     ) -> (Vec<f64>, usize) {
-        let out = if tol.to_array() == [0.0; 5] {
+        let out = if tol.is_zero() {
             // Without errors every sample is the exact compensated launch (a zero
             // tolerance draws zero errors, and a zero error changes no bit): one will do.
             let one = self.samples(params, tol, 0..n.min(1), seed, pool, &());
@@ -485,7 +522,7 @@ impl<'a> Budget<'a> {
         else {
             return false;
         };
-        if tol.to_array() == [0.0; 5] {
+        if tol.is_zero() {
             let (ious, _) = self.monte_carlo(params, tol, n.min(1), seed, pool, &());
             let each = ious.first().is_some_and(|&x| x >= threshold);
             return if each { n >= needed } else { needed == 0 };

@@ -65,6 +65,9 @@ pub fn tolerances(r: &BudgetReport) -> Option<Result<Figure, PictureError>> {
         ),
         panels,
         y_label: "IoU / probability".to_string(),
-        marker_name: format!("largest tolerance (P(IoU >= {threshold}) >= 95 %)"),
+        marker_name: format!(
+            "largest tolerance (P(IoU >= {threshold}) >= {:.0} %)",
+            100.0 * super::PROBABILITY_TARGET
+        ),
     }))
 }

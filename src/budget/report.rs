@@ -119,7 +119,7 @@ pub struct CurvePoint {
 pub struct SingleTolerance {
     pub parameter: String,
     pub unit: String,
-    /// Largest 1-sigma size keeping P(IoU >= threshold) >= 95 % (the others zero).
+    /// Largest 1-sigma size keeping P(IoU >= threshold) >= 90 % (the others zero).
     pub largest: f64,
     /// True when even the accepted limit keeps it (no limit found within range).
     pub at_limit: bool,
@@ -132,10 +132,91 @@ pub struct ToleranceSearch {
     pub samples_per_evaluation: usize,
     pub single: Vec<SingleTolerance>,
     /// Largest common factor on the requested tolerances keeping
-    /// P(IoU >= threshold) >= 95 %.
+    /// P(IoU >= threshold) >= [`super::PROBABILITY_TARGET`].
     pub joint_scale: f64,
     pub joint_tolerances: Tolerances,
     pub joint_at_limit: bool,
+}
+
+/// What launcher a solution needs: the largest 1-sigma error of each of the launcher's
+/// kinds alone, and the largest factor on the whole default launcher model, that keep
+/// `P(IoU >= threshold) >= probability`, the threshold [`super::NEEDS_MARGIN`] below the
+/// solution's IoU; flown in a vacuum, as the solver flies (`bsa budget` adds the air).
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+pub struct LauncherNeeds {
+    /// The solution's IoU at `t`.
+    pub iou: f64,
+    pub threshold: f64,
+    pub probability: f64,
+    /// Draws per evaluation.
+    pub samples: usize,
+    pub single: Vec<NeededTolerance>,
+    /// The default launcher model's errors may be this many times larger (below 1: the
+    /// launcher must be this much better than the model).
+    pub scale: f64,
+    pub scale_at_limit: bool,
+}
+
+/// One error kind of [`LauncherNeeds`].
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+pub struct NeededTolerance {
+    pub parameter: String,
+    pub unit: String,
+    /// The largest 1-sigma error of this kind alone.
+    pub largest: f64,
+    /// The search stopped at the largest error it accepts.
+    pub at_limit: bool,
+    /// The default launcher model's error of this kind.
+    pub model: f64,
+}
+
+impl LauncherNeeds {
+    /// A table in Markdown, with what it means above it.
+    pub fn markdown(&self) -> String {
+        let mut md = format!(
+            "The largest 1-sigma error of each kind alone that keeps P(IoU >= {:.3}) >= {:.0} % (the solution's IoU {:.4} less {}), in a vacuum, {} draws per evaluation:\n\n| error | largest | default launcher |\n|---|---|---|\n",
+            self.threshold,
+            100.0 * self.probability,
+            self.iou,
+            super::NEEDS_MARGIN,
+            self.samples
+        );
+        for n in &self.single {
+            let more = if n.at_limit { " or more" } else { "" };
+            md.push_str(&format!(
+                "| {} | {} {}{more} | {} {} |\n",
+                n.parameter.replace('_', " "),
+                significant(n.largest),
+                n.unit,
+                super::short(n.model),
+                n.unit
+            ));
+        }
+        let verdict = if self.scale >= 1.0 {
+            format!(
+                "the default launcher's errors may be {} times larger",
+                significant(self.scale)
+            )
+        } else if self.scale > 0.0 {
+            format!(
+                "the launcher must be {} times more precise than the default",
+                significant(1.0 / self.scale)
+            )
+        } else {
+            "no launcher precision is enough".to_string()
+        };
+        md.push_str(&format!("\nAll together: {verdict}.\n"));
+        md
+    }
+}
+
+/// `x` to three significant digits (0.00977, 0.191, 12.6, 450).
+fn significant(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let digits = (2 - x.abs().log10().floor() as i32).max(0) as usize;
+    format!("{x:.digits$}")
 }
 
 /// Why the threshold cannot be reached: even the exact compensated launch is below it.
@@ -293,11 +374,14 @@ impl BudgetReport {
         );
         let _ = writeln!(
             s,
-            "1-sigma errors per body: speed {} %, direction {} deg, spin {} %, release timing {} ms, drag coefficient {} %.\n",
+            "1-sigma errors per body: speed {} %, direction {} deg, spin {} %, release timing {} ms, position {} mm, orientation {} deg, spin floor {} rad/s, drag coefficient {} %.\n",
             short(t.speed_pct),
             short(t.direction_deg),
             short(t.spin_pct),
             short(t.timing_ms),
+            short(t.position_mm),
+            short(t.orientation_deg),
+            short(t.spin_floor_rad_s),
             short(t.cd_pct)
         );
         let _ = writeln!(
@@ -375,17 +459,19 @@ impl BudgetReport {
                 p.unit
             );
         }
-        let j = &se.joint_tolerances;
+        let joint: Vec<String> = se
+            .joint_tolerances
+            .to_array()
+            .iter()
+            .zip(PARAMETERS)
+            .map(|(v, (name, unit, _))| format!("{} {v:.4} {unit}", name.replace('_', " ")))
+            .collect();
         let _ = writeln!(
             s,
-            "\nAll together, the requested tolerances scaled by {}{:.4}: speed {:.4} %, direction {:.4} deg, spin {:.4} %, timing {:.4} ms, Cd {:.4} %.\n",
+            "\nAll together, the requested tolerances scaled by {}{:.4}: {}.\n",
             if se.joint_at_limit { ">= " } else { "" },
             se.joint_scale,
-            j.speed_pct,
-            j.direction_deg,
-            j.spin_pct,
-            j.timing_ms,
-            j.cd_pct
+            joint.join(", ")
         );
         let _ = writeln!(s, "![IoU against each tolerance](budget_tolerances.png)\n");
     }

@@ -113,15 +113,21 @@ pub(super) fn largest(start: f64, limit: f64, ok: &mut dyn FnMut(f64) -> bool) -
     (lo, false)
 }
 
-pub(super) fn search(
+/// The largest size of each error kind of `kinds` alone (none for an empty range), and
+/// the largest common factor on `base`, that keep `P(IoU >= threshold) >= PROBABILITY_TARGET` over `m` samples:
+/// (size, at its limit) per kind, then (factor, at its limit).
+type Largest = (Vec<(f64, bool)>, (f64, bool));
+
+/// The search of [`Largest`], each kind's bracket starting from `start` and bounded by
+/// [`PARAMETERS`] (the timing also by a third of `t`).
+fn largest_each(
     b: &Budget,
     comp: &[f64],
-    opts: &BudgetOptions,
+    (kinds, base, start): (std::ops::Range<usize>, &Tolerances, &Tolerances),
+    (m, seed, threshold): (usize, u64, f64),
     pool: &rayon::ThreadPool,
     progress: &dyn Progress,
-) -> ToleranceSearch {
-    let m = opts.search_samples;
-    let seed = opts.seed;
+) -> Largest {
     let t = b.problem.scene.t;
     let limits: Vec<f64> = PARAMETERS
         .iter()
@@ -133,65 +139,204 @@ pub(super) fn search(
             }
         })
         .collect();
-    let defaults = Tolerances::default().to_array();
-    let user = opts.tolerances.to_array();
-    let stats = |tol: &Tolerances| {
-        let (ious, diverged) = b.monte_carlo(comp, tol, m, seed, pool, &());
-        IouStats::new(&ious, diverged, opts.iou_threshold)
-    };
-    let ok = |tol: &Tolerances| b.reaches(comp, tol, m, seed, opts.iou_threshold, pool);
-    progress.start("tolerance search", 6);
-    let mut single = Vec::new();
-    for (p, (name, unit, _)) in PARAMETERS.iter().enumerate() {
-        let at = |s: f64| {
-            let mut a = [0.0; 5];
-            a[p] = s;
-            Tolerances::from_array(a)
-        };
-        let start = if user[p] > 0.0 { user[p] } else { defaults[p] };
-        let (best, at_limit) = largest(start, limits[p], &mut |s| ok(&at(s)));
-        let top = if best > 0.0 { 2.0 * best } else { 2.0 * start }.min(limits[p]);
-        let curve = (0..CURVE_POINTS)
-            .map(|j| {
-                let size = top * j as f64 / (CURVE_POINTS - 1) as f64;
-                let s = stats(&at(size));
-                CurvePoint {
-                    size,
-                    mean: s.mean,
-                    p5: s.p5,
-                    p_iou_at_least_threshold: s.p_iou_at_least_threshold,
-                }
-            })
-            .collect();
-        single.push(SingleTolerance {
-            parameter: name.to_string(),
-            unit: unit.to_string(),
-            largest: best,
-            at_limit,
-            curve,
-        });
-        progress.advance(1);
-    }
-    // The largest common factor on the requested tolerances.
-    let max_scale = user
-        .iter()
-        .zip(&limits)
-        .filter(|(u, _)| **u > 0.0)
-        .map(|(u, l)| l / u)
+    let ok = |tol: &Tolerances| b.reaches(comp, tol, m, seed, threshold, pool);
+    let start = start.to_array();
+    let single = kinds
+        .clone()
+        .map(|p| {
+            let at = |s: f64| {
+                let mut a = [0.0; KINDS];
+                a[p] = s;
+                Tolerances::from_array(a)
+            };
+            let r = largest(start[p], limits[p], &mut |s| ok(&at(s)));
+            progress.advance(1);
+            r
+        })
+        .collect();
+    let base = base.to_array();
+    let max_scale = (0..KINDS)
+        .filter(|&p| base[p] > 0.0)
+        .map(|p| limits[p] / base[p])
         .fold(f64::INFINITY, f64::min);
-    let (joint_scale, joint_at_limit) = if max_scale.is_finite() {
-        let scaled = |s: f64| Tolerances::from_array(user.map(|u| u * s));
+    let joint = if max_scale.is_finite() {
+        let scaled = |s: f64| Tolerances::from_array(base.map(|u| u * s));
         largest(1.0, max_scale, &mut |s| ok(&scaled(s)))
     } else {
         (0.0, false)
     };
     progress.advance(1);
+    (single, joint)
+}
+
+pub(super) fn search(
+    b: &Budget,
+    comp: &[f64],
+    opts: &BudgetOptions,
+    pool: &rayon::ThreadPool,
+    progress: &dyn Progress,
+) -> ToleranceSearch {
+    let (m, seed) = (opts.search_samples, opts.seed);
+    let user = opts.tolerances;
+    // Each bracket starts from the requested size, or the default where none is asked.
+    let defaults = Tolerances::default().to_array();
+    let start = Tolerances::from_array(std::array::from_fn(|p| {
+        if user.to_array()[p] > 0.0 {
+            user.to_array()[p]
+        } else {
+            defaults[p]
+        }
+    }));
+    let stats = |tol: &Tolerances| {
+        let (ious, diverged) = b.monte_carlo(comp, tol, m, seed, pool, &());
+        IouStats::new(&ious, diverged, opts.iou_threshold)
+    };
+    progress.start("tolerance search", KINDS as u64 + 1);
+    let (found, (joint_scale, joint_at_limit)) = largest_each(
+        b,
+        comp,
+        (0..KINDS, &user, &start),
+        (m, seed, opts.iou_threshold),
+        pool,
+        progress,
+    );
+    let single = found
+        .into_iter()
+        .zip(PARAMETERS)
+        .enumerate()
+        .map(|(p, ((best, at_limit), (name, unit, limit)))| {
+            let top = if best > 0.0 {
+                2.0 * best
+            } else {
+                2.0 * start.to_array()[p]
+            };
+            let top = top.min(if name == "timing" {
+                limit.min(b.problem.scene.t * 1000.0 / 3.0)
+            } else {
+                limit
+            });
+            let curve = (0..CURVE_POINTS)
+                .map(|j| {
+                    let size = top * j as f64 / (CURVE_POINTS - 1) as f64;
+                    let mut a = [0.0; KINDS];
+                    a[p] = size;
+                    let s = stats(&Tolerances::from_array(a));
+                    CurvePoint {
+                        size,
+                        mean: s.mean,
+                        p5: s.p5,
+                        p_iou_at_least_threshold: s.p_iou_at_least_threshold,
+                    }
+                })
+                .collect();
+            SingleTolerance {
+                parameter: name.to_string(),
+                unit: unit.to_string(),
+                largest: best,
+                at_limit,
+                curve,
+            }
+        })
+        .collect();
     progress.finish();
     ToleranceSearch {
         samples_per_evaluation: m,
         single,
         joint_scale,
-        joint_tolerances: Tolerances::from_array(user.map(|u| u * joint_scale)),
+        joint_tolerances: Tolerances::from_array(user.to_array().map(|u| u * joint_scale)),
         joint_at_limit,
     }
+}
+
+/// What launcher a solution needs ([`LauncherNeeds`]): in a vacuum, as the solver flies,
+/// on [`NEEDS_SAMPLES`] draws per evaluation with `seed`.
+pub fn needs(
+    problem: &Problem,
+    params: &[f64],
+    seed: u64,
+    threads: Option<usize>,
+) -> Result<LauncherNeeds, BudgetError> {
+    let b = Budget::vacuum(problem, params)?;
+    let threshold = b.vacuum_iou - NEEDS_MARGIN;
+    let model = Tolerances {
+        cd_pct: 0.0,
+        ..Tolerances::default()
+    };
+    let pool = thread_pool(threads);
+    let (found, (scale, scale_at_limit)) = largest_each(
+        &b,
+        params,
+        (0..KINDS - 1, &model, &model),
+        (NEEDS_SAMPLES, seed, threshold),
+        &pool,
+        &(),
+    );
+    let single = found
+        .into_iter()
+        .zip(PARAMETERS)
+        .zip(model.to_array())
+        .map(
+            |(((largest, at_limit), (name, unit, _)), model)| NeededTolerance {
+                parameter: name.to_string(),
+                unit: unit.to_string(),
+                largest,
+                at_limit,
+                model,
+            },
+        )
+        .collect();
+    Ok(LauncherNeeds {
+        iou: b.vacuum_iou,
+        threshold,
+        probability: PROBABILITY_TARGET,
+        samples: NEEDS_SAMPLES,
+        single,
+        scale,
+        scale_at_limit,
+    })
+}
+
+/// `P(IoU >= IoU - NEEDS_MARGIN)` of launch `params` at the launcher `tol` over `samples`
+/// draws from `seed`, in a vacuum, on the calling thread (callers run several side by
+/// side), with the solution's IoU.
+pub fn probability(
+    problem: &Problem,
+    params: &[f64],
+    tol: &Tolerances,
+    samples: usize,
+    seed: u64,
+) -> Result<(f64, f64), BudgetError> {
+    let b = Budget::vacuum(problem, params)?;
+    let threshold = b.vacuum_iou - NEEDS_MARGIN;
+    let (ious, diverged) = b.monte_carlo(params, tol, samples, seed, &thread_pool(Some(1)), &());
+    let stats = IouStats::new(&ious, diverged, threshold);
+    Ok((stats.p_iou_at_least_threshold, b.vacuum_iou))
+}
+
+/// The largest factor on the launcher `tol` that keeps `P(IoU >= IoU - NEEDS_MARGIN) >=
+/// PROBABILITY_TARGET` for launch `params` over `samples` draws from `seed`, in a vacuum,
+/// on the calling thread (as [`probability`]); 0 when even a perfect launcher is not
+/// enough.
+pub fn launcher_scale(
+    problem: &Problem,
+    params: &[f64],
+    tol: &Tolerances,
+    samples: usize,
+    seed: u64,
+) -> Result<f64, BudgetError> {
+    let b = Budget::vacuum(problem, params)?;
+    let threshold = b.vacuum_iou - NEEDS_MARGIN;
+    let base = Tolerances {
+        cd_pct: 0.0,
+        ..*tol
+    };
+    let (_, (scale, _)) = largest_each(
+        &b,
+        params,
+        (0..0, &base, &base),
+        (samples, seed, threshold),
+        &thread_pool(Some(1)),
+        &(),
+    );
+    Ok(scale)
 }

@@ -156,7 +156,7 @@ fn same_seed_gives_bit_identical_json_with_1_and_2_threads() {
     assert_ne!(a.ious, c.ious);
     // No errors at all: every sample is the compensated launch.
     let mut o = small_options(2);
-    o.tolerances = Tolerances::from_array([0.0; 5]);
+    o.tolerances = Tolerances::ZERO;
     o.search_samples = 0;
     let d = run(&p, &MICKEY, &o, &()).unwrap();
     assert!(d.ious.iter().all(|&x| x == d.report.iou_drag_compensated));
@@ -322,7 +322,16 @@ fn bad_input_gets_clear_errors() {
         matches!(e, BudgetError::Drag(DragError::Coefficient { .. })),
         "{msg}"
     );
-    for (k, v) in [(0, -1.0), (1, 90.0), (2, f64::NAN), (3, 500.0), (4, 60.0)] {
+    for (k, v) in [
+        (0, -1.0),
+        (1, 90.0),
+        (2, f64::NAN),
+        (3, 500.0),
+        (4, 160.0),
+        (5, 90.0),
+        (6, -0.1),
+        (7, 60.0),
+    ] {
         let mut a = good.tolerances.to_array();
         a[k] = v;
         let (msg, e) = bad(BudgetOptions {
@@ -330,7 +339,7 @@ fn bad_input_gets_clear_errors() {
             ..good.clone()
         });
         assert!(
-            matches!(e, BudgetError::Tolerance { name, .. } if name == PARAMETERS[k].0),
+            matches!(e, BudgetError::Tolerance(ref t) if t.name == PARAMETERS[k].0),
             "{msg}"
         );
         assert!(

@@ -8,12 +8,14 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 
 use crate::budget::{
-    self, plots, short, BudgetError, BudgetOptions, BudgetReport, BudgetRun, Tolerances,
+    self, plots, short, BudgetError, BudgetOptions, BudgetReport, BudgetRun, Tolerances, KINDS,
+    PARAMETERS,
 };
 use crate::evaluate::Problem;
 use crate::output::files;
 use crate::sim::drag::{DragConfig, DragError};
 
+use super::launcher::{LauncherArgs, FLAGS};
 use super::progress::BudgetProgress;
 use super::{load, BudgetArgs};
 
@@ -25,6 +27,8 @@ pub(super) struct Options {
     path: PathBuf,
     scene: Option<PathBuf>,
     budget: BudgetOptions,
+    /// The launcher's errors, resolved against the scene ([`BudgetOptions::tolerances`]).
+    launcher: LauncherArgs,
     quiet: bool,
 }
 
@@ -40,13 +44,7 @@ impl Options {
         }
         let budget = BudgetOptions {
             drag,
-            tolerances: Tolerances {
-                speed_pct: args.speed_tol,
-                direction_deg: args.direction_tol,
-                spin_pct: args.spin_tol,
-                timing_ms: args.timing_tol,
-                cd_pct: args.cd_tol,
-            },
+            tolerances: Tolerances::default(),
             samples: args.samples,
             search_samples: args.search_samples,
             seed: args.seed,
@@ -57,23 +55,30 @@ impl Options {
             path: args.path,
             scene: args.scene,
             budget,
+            launcher: args.launcher,
             quiet: args.quiet,
         }
     }
 
-    /// Check every budget option (drag, tolerances, sample counts, threads, threshold)
-    /// against the scene, before any simulation runs. The error names the flag to
-    /// change, then what is wrong with its value.
-    fn validate(&self, problem: &Problem) -> Result<()> {
-        budget::validate_options(problem, &self.budget).map_err(|e| match flag_of(&e) {
+    /// The budget's options with the launcher resolved against the scene, every option
+    /// (drag, tolerances, sample counts, threads, threshold) checked before any
+    /// simulation runs. The error names the flag to change, then what is wrong with its
+    /// value.
+    fn validate(&self, problem: &Problem) -> Result<BudgetOptions> {
+        let opts = BudgetOptions {
+            tolerances: self.launcher.resolve(&problem.scene)?,
+            ..self.budget.clone()
+        };
+        budget::validate_options(problem, &opts).map_err(|e| match flag_of(&e) {
             Some(flag) => anyhow::anyhow!("{flag}: {e}"),
             None => anyhow::Error::new(e).context("invalid budget options"),
         })?;
         check_some_error(
-            &self.budget.tolerances,
+            &opts.tolerances,
             true,
             "every Monte Carlo launch would be the compensated launch itself, and there would be no requested tolerance to scale",
-        )
+        )?;
+        Ok(opts)
     }
 
     /// The output folder and the solution file of [`Options::path`].
@@ -91,24 +96,15 @@ impl Options {
     }
 }
 
-/// The flags of the launch errors, in the order of [`Tolerances::to_array`].
-const TOLERANCE_FLAGS: [&str; 5] = [
-    "--speed-tol",
-    "--direction-tol",
-    "--spin-tol",
-    "--timing-tol",
-    "--cd-tol",
-];
-
 /// Refuses launch errors that are all zero, naming their flags: every perturbed launch
 /// would then be the nominal one, and `why` says what that makes of the command.
 /// `with_cd`: whether the drag coefficient's error is one of them (it is only with air).
 pub(super) fn check_some_error(t: &Tolerances, with_cd: bool, why: &str) -> Result<()> {
-    let n = if with_cd { 5 } else { 4 };
+    let n = if with_cd { KINDS } else { KINDS - 1 };
     if t.to_array()[..n].iter().all(|&x| x == 0.0) {
         bail!(
             "{} are all 0: {why}; give at least one of them a tolerance above 0",
-            TOLERANCE_FLAGS[..n].join(", ")
+            FLAGS[..n].join(", ")
         );
     }
     Ok(())
@@ -120,14 +116,10 @@ pub(super) fn flag_of(e: &BudgetError) -> Option<&'static str> {
     Some(match e {
         BudgetError::Drag(DragError::Density(_)) => "--rho",
         BudgetError::Drag(DragError::Coefficient { .. }) => "--cd",
-        BudgetError::Tolerance { name, .. } => match *name {
-            "speed" => "--speed-tol",
-            "direction" => "--direction-tol",
-            "spin" => "--spin-tol",
-            "timing" => "--timing-tol",
-            "cd" => "--cd-tol",
-            _ => return None,
-        },
+        BudgetError::Tolerance(e) => {
+            let k = PARAMETERS.iter().position(|p| p.0 == e.name)?;
+            FLAGS[k]
+        }
         BudgetError::Samples { what, .. } if *what == "samples" => "--samples",
         BudgetError::Samples { what, .. } if *what == "search samples" => "--search-samples",
         BudgetError::Threads => "--threads",
@@ -141,7 +133,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let (dir, file) = opts.dir_and_file();
     let (problem, solution, scene_path) =
         load::solution_and_scene(&dir, &file, opts.scene.as_deref())?;
-    opts.validate(&problem)?;
+    let budget_opts = opts.validate(&problem)?;
     budget::check_solution_current(&problem, &solution).with_context(|| {
         format!(
             "{} does not belong to the scene {} (pass the right one with --scene)",
@@ -151,7 +143,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     })?;
     let bars = BudgetProgress::new(opts.quiet);
     let start = Instant::now();
-    let run = budget::run(&problem, &solution.parameters(), &opts.budget, &bars)?;
+    let run = budget::run(&problem, &solution.parameters(), &budget_opts, &bars)?;
     let elapsed = start.elapsed().as_secs_f64();
     let r = &run.report;
     write_files(&dir, &problem, &run, opts.budget.threads, elapsed)?;

@@ -34,6 +34,7 @@ mod eval;
 mod export;
 mod frames;
 pub mod guard;
+mod launcher;
 mod load;
 mod new;
 mod outdir;
@@ -182,22 +183,9 @@ struct SolveArgs {
     /// launches instead of its mean, in (0, 1) (e.g. 0.9: the best 90 %).
     #[arg(long, value_name = "Q", allow_negative_numbers = true)]
     quantile: Option<f64>,
-    /// With --robust: launch speed error, 1 sigma (% of the speed) [default: 0.5].
-    #[arg(long, allow_negative_numbers = true)]
-    speed_tol: Option<f64>,
-    /// With --robust: launch direction error, 1 sigma per perpendicular component (deg)
-    /// [default: 0.25].
-    #[arg(long, allow_negative_numbers = true)]
-    direction_tol: Option<f64>,
-    /// With --robust: spin rate error, 1 sigma (% of the angular speed) [default: 2].
-    #[arg(long, allow_negative_numbers = true)]
-    spin_tol: Option<f64>,
-    /// With --robust: release timing error, 1 sigma (ms) [default: 1].
-    #[arg(long, allow_negative_numbers = true)]
-    timing_tol: Option<f64>,
-    /// With --robust --air: drag coefficient error, 1 sigma (% of Cd) [default: 5].
-    #[arg(long, allow_negative_numbers = true)]
-    cd_tol: Option<f64>,
+    /// With --robust: the launcher's errors to optimise under.
+    #[command(flatten)]
+    launcher: launcher::LauncherArgs,
     /// Optimise the launch positions too (x and y on the table; bounded to the table's
     /// top, contact-free at launch), as the scene's `"positions": "free"` does.
     #[arg(long)]
@@ -336,23 +324,11 @@ struct BudgetArgs {
     /// Magnus lift on spinning spheres.
     #[arg(long)]
     magnus: bool,
-    /// Launch speed error, 1 sigma (% of the speed).
-    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
-    speed_tol: f64,
-    /// Launch direction error, 1 sigma per perpendicular component (deg).
-    #[arg(long, default_value_t = 0.25, allow_negative_numbers = true)]
-    direction_tol: f64,
-    /// Spin rate error, 1 sigma (% of the angular speed).
-    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
-    spin_tol: f64,
-    /// Release timing error, 1 sigma (ms).
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
-    timing_tol: f64,
-    /// Drag coefficient error, 1 sigma (% of Cd).
-    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
-    cd_tol: f64,
+    /// The launcher's errors.
+    #[command(flatten)]
+    launcher: launcher::LauncherArgs,
     /// IoU a sample must reach to count as a success, in (0, 1]: the Monte Carlo
-    /// reports P(IoU >= X) and the tolerance search keeps it >= 95 %.
+    /// reports P(IoU >= X) and the tolerance search keeps it >= 90 %.
     #[arg(long, value_name = "X", default_value_t = crate::budget::IOU_THRESHOLD, allow_negative_numbers = true)]
     iou_threshold: f64,
     /// No progress bars.
@@ -417,6 +393,15 @@ struct NewArgs {
     /// `start` keeps the best start guess (no solve).
     #[arg(long, value_enum, default_value_t = new::ChooseBy::Solve)]
     choose_by: new::ChooseBy,
+    /// Design for a launcher: besides the standard design, designs at shorter instants
+    /// (t, t/2, t/4) under lower ceilings, each body launched already in its pose at t
+    /// and without spin; every trial solve is measured at the launcher (the defaults, or
+    /// FILE.json as `bsa budget --launcher` reads it), and the design kept is the one most
+    /// likely to read among those within 0.03 of the best IoU. Writes the frontier of
+    /// every design tried (frontier.md, frontier.csv, frontier.png) beside the scene,
+    /// and the launcher into the scene.
+    #[arg(long, value_name = "FILE.json", num_args = 0..=1)]
+    launcher: Option<Option<PathBuf>>,
     #[command(flatten)]
     design: DesignArgs,
 }

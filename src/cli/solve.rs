@@ -16,6 +16,7 @@ use crate::output::solution::{self, SampleRecord, Solution};
 use crate::scene::{LaunchPositions, Scene};
 use crate::sim::drag::DragConfig;
 
+use super::launcher::LauncherArgs;
 use super::progress::SolveProgress;
 use super::{export, frames, guard, load, outdir, SolveArgs};
 use crate::evaluate::MAX_THREADS;
@@ -46,6 +47,8 @@ pub(super) struct Options {
     /// Launch errors to optimise under (`--robust`), tolerances checked against `t` once
     /// the scene is loaded.
     robust: Option<Robust>,
+    /// The launcher's errors of `--robust`, resolved against the scene.
+    launcher: LauncherArgs,
     free_positions: bool,
 }
 
@@ -81,13 +84,6 @@ impl Options {
             ),
             limit => limit.map(std::time::Duration::from_secs_f64),
         };
-        let tolerances = [
-            ("--speed-tol", args.speed_tol),
-            ("--direction-tol", args.direction_tol),
-            ("--spin-tol", args.spin_tol),
-            ("--timing-tol", args.timing_tol),
-            ("--cd-tol", args.cd_tol),
-        ];
         let robust = if args.robust {
             let draws = args.draws.unwrap_or(DEFAULT_DRAWS);
             if !(1..=MAX_DRAWS).contains(&draws) {
@@ -107,28 +103,12 @@ impl Options {
                     );
                 }
             }
-            if args.cd_tol.is_some() && !args.air {
+            if args.launcher.cd_given() && !args.air {
                 bail!("--cd-tol is the error of the drag model: it needs --air");
             }
-            let d = Tolerances::default();
-            let mut t = Tolerances {
-                speed_pct: args.speed_tol.unwrap_or(d.speed_pct),
-                direction_deg: args.direction_tol.unwrap_or(d.direction_deg),
-                spin_pct: args.spin_tol.unwrap_or(d.spin_pct),
-                timing_ms: args.timing_tol.unwrap_or(d.timing_ms),
-                cd_pct: args.cd_tol.unwrap_or(d.cd_pct),
-            };
-            // In a vacuum there is no drag coefficient to be wrong.
-            if !args.air {
-                t.cd_pct = 0.0;
-            }
-            super::budget::check_some_error(
-                &t,
-                args.air,
-                "every perturbed launch would be the nominal one, and --robust would optimise the plain objective (leave out --robust for that)",
-            )?;
             Some(Robust {
-                tolerances: t,
+                // Resolved against the scene's launcher once it is loaded.
+                tolerances: Tolerances::default(),
                 draws,
                 reference_draws: (4 * draws).max(REFERENCE_DRAWS),
                 quantile: args.quantile,
@@ -139,9 +119,10 @@ impl Options {
                 ("--quantile", args.quantile.is_some()),
             ]
             .into_iter()
-            .chain(tolerances.iter().map(|(n, v)| (*n, v.is_some())))
-            .find(|(_, g)| *g);
-            if let Some((name, _)) = given {
+            .find(|(_, g)| *g)
+            .map(|(n, _)| n)
+            .or(args.launcher.first_given());
+            if let Some(name) = given {
                 bail!("{name} is an option of --robust: add --robust");
             }
             None
@@ -159,6 +140,7 @@ impl Options {
             quiet: args.quiet,
             air: args.air,
             robust,
+            launcher: args.launcher,
             free_positions: args.free_positions,
         })
     }
@@ -242,20 +224,27 @@ fn problem(opts: &Options, mut scene: crate::scene::Scene) -> Result<Problem> {
         }
         scene.positions = LaunchPositions::Free;
     }
-    if let Some(r) = &opts.robust {
-        if let Err(e) = r.tolerances.validate(scene.t) {
-            // Named by the flag to change, as `bsa budget` names it.
-            match super::budget::flag_of(&e) {
-                Some(flag) => bail!("{flag}: {e}"),
-                None => return Err(anyhow::Error::new(e).context("the tolerances of --robust")),
+    let robust = match opts.robust {
+        Some(r) => {
+            let mut t = opts.launcher.resolve(&scene)?;
+            // In a vacuum there is no drag coefficient to be wrong.
+            if !opts.air {
+                t.cd_pct = 0.0;
             }
+            super::budget::check_some_error(
+                &t,
+                opts.air,
+                "every perturbed launch would be the nominal one, and --robust would optimise the plain objective (leave out --robust for that)",
+            )?;
+            Some(Robust { tolerances: t, ..r })
         }
-    }
+        None => None,
+    };
     let mut problem = Problem::new(scene);
     if opts.air {
         problem.set_air(DragConfig::default());
     }
-    if let Some(r) = opts.robust {
+    if let Some(r) = robust {
         problem.set_robust(r);
     }
     Ok(problem)
@@ -336,9 +325,12 @@ fn solve_into(
     plotted?;
     let written = pictures?;
     clock.lap("convergence plot beside shadow, overlay, preview and exports");
+    let needs = write_needs(&out, problem, &solution, opts.threads)?;
+    clock.lap("what launcher it needs");
     let report = crate::output::report::write_report(&out, &solution)?;
     clock.lap("report page");
     print_summary(scene, problem, &solution, &out, &written);
+    println!("{needs}");
     println!("report: {}", report.display());
     if opts.report {
         print_report(&solution, &clock);
@@ -598,6 +590,31 @@ impl Clock {
     fn restart_lap(&mut self) {
         self.lap = std::time::Instant::now();
     }
+}
+
+/// What launcher `solution` needs ([`crate::budget::needs`]), written to `out/launcher.json`
+/// and `out/launcher.md` (which the report page shows); returns the line to print.
+fn write_needs(
+    out: &Path,
+    problem: &Problem,
+    solution: &Solution,
+    threads: Option<usize>,
+) -> Result<String> {
+    let needs = crate::budget::needs(problem, &solution.parameters(), solution.seed, threads)?;
+    files::write_atomic(
+        &out.join("launcher.json"),
+        serde_json::to_string_pretty(&needs)?.as_bytes(),
+    )?;
+    let md = format!("# What launcher it needs\n\n{}", needs.markdown());
+    files::write_atomic(&out.join("launcher.md"), md.as_bytes())?;
+    let all = md.lines().last().unwrap_or_default();
+    Ok(format!(
+        "launcher it needs (P(IoU >= {:.3}) >= {:.0} %, in {}/launcher.md): {}",
+        needs.threshold,
+        100.0 * needs.probability,
+        out.display(),
+        all.trim_start_matches("All together: ")
+    ))
 }
 
 /// The performance report of `--report`.

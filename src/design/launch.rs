@@ -18,7 +18,7 @@ use serde_json::{json, Value};
 use super::assign::assign;
 use super::cover::{to_pixel, Frame, Placement};
 use super::plant::default_strategy;
-use super::pose::{families, rest_radius, Family, Pose};
+use super::pose::{families, lift_at, rest_radius, Family, Pose};
 use crate::geometry::shape::{MassProperties, Shape};
 use crate::shadow::raster::ShadowCamera;
 use crate::sim::flight::{FlightConfig, FreeFlight, LaunchState};
@@ -51,6 +51,10 @@ pub struct Geometry {
     /// The highest flight at `t`, as a fraction of the light's height above the
     /// receiver (one of [`super::CEILINGS`]).
     pub ceiling: f64,
+    /// Every body starts already in its pose at `t` (a launcher holds it so) and flies
+    /// without spin, so that a launcher's spin error has no spin to scale; else it rests
+    /// on the table and turns into its pose in flight.
+    pub posed: bool,
 }
 
 impl Geometry {
@@ -144,14 +148,15 @@ impl Plan {
     /// pictures, half as many slots again as objects.
     fn slot_grid(&self) -> Vec<DVec2> {
         let cam = &self.geometry.camera;
-        let rho = self
-            .objects
-            .iter()
-            .map(|p| rest_radius(&p.object.shape, p.pose.rest))
+        let rho = (0..self.objects.len())
+            .map(|k| rest_radius(&self.objects[k].object.shape, self.launch_turn(k)))
             .fold(0.0, f64::max);
         let pitch = 2.0 * rho + rho.max(0.05);
         let n = self.objects.len();
         let wanted = (3 * n).div_ceil(2).max(1);
+        if self.geometry.posed {
+            return ring_slots(cam, rho, pitch, wanted);
+        }
         let cols = ((1.75 * cam.width_m / pitch).floor() as usize + 1)
             .min(wanted)
             .max(1);
@@ -193,6 +198,15 @@ impl Plan {
         }
     }
 
+    /// Object `k`'s orientation at launch before its yaw: its rest pose, or its pose
+    /// at `t` when [`Geometry::posed`].
+    fn launch_turn(&self, k: usize) -> DQuat {
+        match self.geometry.posed {
+            true => self.unyawed(k),
+            false => self.objects[k].pose.rest,
+        }
+    }
+
     /// The launch of object `k`.
     pub fn start(&self, k: usize) -> Start {
         let g = &self.geometry;
@@ -200,16 +214,23 @@ impl Plan {
         let yaw = DQuat::from_rotation_z(o.placement.theta);
         let q_t = yaw * self.unyawed(k);
         let origin_t = self.centre_at_t(k) - yaw * o.pose.centre;
-        let q0 = yaw * o.pose.rest;
+        let q0 = yaw * self.launch_turn(k);
         let slot = self.slots[o.slot];
-        let origin0 = DVec3::new(slot.x, slot.y, g.table_top + o.pose.lift + 1e-6);
+        let lift = match g.posed {
+            true => lift_at(&o.object.shape, q0),
+            false => o.pose.lift,
+        };
+        let origin0 = DVec3::new(slot.x, slot.y, g.table_top + lift + 1e-6);
         let mass = o.object.shape.mass_properties(o.object.density);
         let com = mass.local_com;
         let (com0, com_t) = (origin0 + q0 * com, origin_t + q_t * com);
         let t = g.t;
         let velocity = (com_t - com0 - 0.5 * g.gravity * t * t) / t;
         let turn = if o.flip { -o.pose.turn } else { o.pose.turn };
-        let angular_velocity = spin_to(&mass, q0, q_t, yaw * o.pose.turn_axis * (turn / t), t);
+        let angular_velocity = match g.posed {
+            true => DVec3::ZERO,
+            false => spin_to(&mass, q0, q_t, yaw * o.pose.turn_axis * (turn / t), t),
+        };
         Start {
             position: origin0,
             orientation: q0,
@@ -292,6 +313,40 @@ impl Plan {
     }
 }
 
+/// At least `wanted` slots around the picture of `cam`, on rings whose first keeps a
+/// body of room `rho` 5 cm off the picture's edge, `pitch` apart along each ring and
+/// between rings: a launcher design launches each body from near where it flies to,
+/// since its miss grows with the length of its flight.
+fn ring_slots(cam: &ShadowCamera, rho: f64, pitch: f64, wanted: usize) -> Vec<DVec2> {
+    let mut out = Vec::with_capacity(wanted);
+    let mut off = rho + 0.05;
+    while out.len() < wanted {
+        let (hx, hy) = (0.5 * cam.width_m + off, 0.5 * cam.height_m + off);
+        let perimeter = 4.0 * (hx + hy);
+        let k = (perimeter / pitch).floor().max(4.0) as usize;
+        for j in 0..k {
+            // Arc length from the front left corner, counter-clockwise.
+            let mut a = perimeter * j as f64 / k as f64;
+            let side = [2.0 * hx, 2.0 * hy, 2.0 * hx, 2.0 * hy];
+            let corners = [(-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)];
+            let dirs = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)];
+            let mut e = 0;
+            while a > side[e] && e < 3 {
+                a -= side[e];
+                e += 1;
+            }
+            let (cx, cy) = corners[e];
+            let (dx, dy) = dirs[e];
+            out.push(DVec2::new(
+                cam.center.x + cx + dx * a,
+                cam.center.y + cy + dy * a,
+            ));
+        }
+        off += pitch;
+    }
+    out
+}
+
 /// The launch spin that turns a body from `q0` to `q_t` in `t` seconds of torque-free
 /// flight. `guess` (the turn's angle over `t` about its axis) is exact when that axis is
 /// a principal axis of the body (a box rolled about its long axis, a body of revolution
@@ -360,6 +415,7 @@ mod tests {
             gravity: DVec3::new(0.0, 0.0, -9.81),
             t: 1.2,
             ceiling: 0.8,
+            posed: false,
         }
     }
 

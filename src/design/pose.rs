@@ -599,14 +599,34 @@ impl Family {
 /// Largest horizontal distance from the body origin to a point of the body in its rest
 /// pose (m): the room it takes on the table, whatever its yaw.
 pub fn rest_radius(shape: &Shape, rest: DQuat) -> f64 {
-    let pts: Vec<DVec3> = match shape {
-        Shape::Sphere { radius } => return *radius,
+    match shape {
+        Shape::Sphere { radius } => *radius,
+        _ => hull_points(shape)
+            .iter()
+            .map(|p| (rest * *p).truncate().length())
+            .fold(0.0, f64::max),
+    }
+}
+
+/// Height of the body origin above the table when the body stands on it turned by `q`
+/// (the launcher holds it so): the depth of its lowest point below the origin (m).
+pub fn lift_at(shape: &Shape, q: DQuat) -> f64 {
+    match shape {
+        Shape::Sphere { radius } => *radius,
+        _ => hull_points(shape)
+            .iter()
+            .map(|p| -(q * *p).z)
+            .fold(f64::NEG_INFINITY, f64::max),
+    }
+}
+
+/// The points whose hull is the body (not for a sphere).
+fn hull_points(shape: &Shape) -> Vec<DVec3> {
+    match shape {
+        Shape::Sphere { .. } => Vec::new(),
         Shape::Cuboid { half_extents } => box_corners(*half_extents).to_vec(),
         Shape::Mesh(m) => m.vertices.clone(),
-    };
-    pts.iter()
-        .map(|p| (rest * *p).truncate().length())
-        .fold(0.0, f64::max)
+    }
 }
 
 #[cfg(test)]

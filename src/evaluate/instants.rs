@@ -37,7 +37,7 @@ use crate::scene::{Hint, HoldObjective, Launch, LaunchPositions, Scene, Stage};
 use crate::shadow::mask::Mask;
 use crate::sim::drag::{BodyDrag, DragConfig};
 use crate::sim::flight::{FreeFlight, LaunchState};
-use crate::sim::launch_error::{aim, draw_errors, BodyError, Tolerances};
+use crate::sim::launch_error::{draw_errors, BodyError, Tolerances};
 
 /// Position values per occluder in the parameter vector when launch positions are free:
 /// the offset `(dx, dy)` (m) of its launch position on the table from the scene's.
@@ -524,9 +524,7 @@ impl Problem {
                     continue;
                 }
                 let e = scratch.errors[i];
-                let mut state = self.launch_state(params, i);
-                state.velocity = aim(state.velocity, e.direction) * (1.0 + e.speed);
-                state.angular_velocity *= 1.0 + e.spin;
+                let state = e.apply(self.launch_state(params, i));
                 diverged |= !(state.velocity.is_finite() && state.angular_velocity.is_finite());
                 let t_max = self.plan.horizon + e.timing.abs();
                 self.start_flight(&mut scratch.flights[i], i, state, e.cd, t_max);

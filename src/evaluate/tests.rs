@@ -313,7 +313,7 @@ fn robust_samples_share_their_errors_within_a_draw() {
     let mut exact = scene("mickey");
     let plain = exact.evaluate(&params, &w, &mut exact.workspace()).total;
     exact.set_robust(Robust {
-        tolerances: crate::sim::launch_error::Tolerances::from_array([0.0; 5]),
+        tolerances: crate::sim::launch_error::Tolerances::ZERO,
         draws: 3,
         reference_draws: 3,
         quantile: Some(0.5),

@@ -90,7 +90,7 @@ pub fn report_html(dir: &Path, s: &Solution) -> Result<String, ExportError> {
     contacts_html(&mut h, s);
     stages_html(&mut h, s);
     passes_html(&mut h, s);
-    budget_html(&mut h, dir)?;
+    budget_html(&mut h, dir, s)?;
     h.push_str("<p><small>Written by bsa (ballistic-shadow-art).</small></p>\n</body></html>\n");
     Ok(h)
 }
@@ -252,14 +252,32 @@ fn stages_html(h: &mut String, s: &Solution) {
     h.push_str("</table>\n");
 }
 
-/// The error budget when `bsa budget` has written `dir/budget.md`: its pictures, then its
-/// Markdown as text; nothing otherwise.
-fn budget_html(h: &mut String, dir: &Path) -> Result<(), ExportError> {
-    let Some(md) = read_optional(&dir.join("budget.md"))? else {
+/// What launcher the solution needs, from `dir/launcher.md` (`bsa solve` writes it); the
+/// frontier of the designs `bsa new --launcher` tried, from the scene's folder; and the
+/// error budget when `bsa budget` has written `dir/budget.md`.
+fn budget_html(h: &mut String, dir: &Path, s: &Solution) -> Result<(), ExportError> {
+    markdown_html(h, dir, "launcher.md", "What launcher it needs", &[])?;
+    if let Some(scene_dir) = s.scene_file.as_deref().and_then(|f| Path::new(f).parent()) {
+        let title = "The designs tried for the launcher";
+        markdown_html(h, scene_dir, "frontier.md", title, &["frontier.png"])?;
+    }
+    markdown_html(h, dir, "budget.md", "Error budget", &BUDGET_PICTURES)
+}
+
+/// A section titled `title` from the Markdown file `name` of `dir`: the `pictures` found
+/// in `dir`, then the Markdown as text; nothing when the file is absent.
+fn markdown_html(
+    h: &mut String,
+    dir: &Path,
+    name: &str,
+    title: &str,
+    pictures: &[&str],
+) -> Result<(), ExportError> {
+    let Some(md) = read_optional(&dir.join(name))? else {
         return Ok(());
     };
-    h.push_str("<h2>Error budget</h2>\n");
-    for file in BUDGET_PICTURES {
+    let _ = writeln!(h, "<h2>{title}</h2>");
+    for &file in pictures {
         if let Some(bytes) = read_optional(&dir.join(file))? {
             let _ = writeln!(h, "<p>{}</p>", img_tag(&bytes, file));
         }

@@ -114,6 +114,7 @@ type Result<T> = std::result::Result<T, SceneError>;
 
 mod bounds;
 mod launch;
+pub mod launcher;
 mod pictures;
 mod raw;
 mod start;
@@ -328,6 +329,8 @@ pub struct Scene {
     pub seed: u64,
     /// How the optimizer treats a contact before `t`.
     pub contacts: Contacts,
+    /// The launcher the scene is made for (its `"launcher"`, else the defaults).
+    pub launcher: launcher::Tolerances,
 }
 
 /// How the optimizer treats a sample with a contact before `t` (a landing included).

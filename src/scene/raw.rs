@@ -31,6 +31,8 @@ pub(super) struct RawScene {
     pub(super) strategy: Option<RawStrategy>,
     pub(super) seed: Option<u64>,
     pub(super) contacts: Option<String>,
+    /// The launcher's 1-sigma errors; a field left out keeps its default.
+    pub(super) launcher: Option<super::launcher::Tolerances>,
 }
 
 #[derive(Deserialize)]

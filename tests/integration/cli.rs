@@ -729,6 +729,9 @@ fn budget_errors_name_the_flag_to_change() {
         ("--direction-tol", "-1", "direction tolerance"),
         ("--spin-tol", "200", "spin tolerance"),
         ("--timing-tol", "-2", "timing tolerance"),
+        ("--position-tol", "200", "position tolerance"),
+        ("--orientation-tol", "-1", "orientation tolerance"),
+        ("--spin-floor-tol", "99", "spin floor tolerance"),
         ("--cd-tol", "99", "cd tolerance"),
         ("--samples", "0", "samples"),
         ("--search-samples", "100000000", "search samples"),
@@ -742,6 +745,20 @@ fn budget_errors_name_the_flag_to_change() {
             "{flag} {value}: {err}"
         );
     }
+    // A launcher file: a misspelt field and a value out of range, each named with it.
+    let file = out.join("launcher.json");
+    std::fs::write(&file, r#"{"direction": 0.1}"#).unwrap();
+    let (ok, _, err) = bsa(&["budget", dir, "--launcher", file.to_str().unwrap(), "-q"]);
+    assert!(
+        !ok && err.contains("launcher.json") && err.contains("unknown field `direction`"),
+        "{err}"
+    );
+    std::fs::write(&file, r#"{"position_mm": 500}"#).unwrap();
+    let (ok, _, err) = bsa(&["budget", dir, "--launcher", file.to_str().unwrap(), "-q"]);
+    assert!(
+        !ok && err.contains("launcher.json: the position tolerance"),
+        "{err}"
+    );
     // No launch error at all: every Monte Carlo launch would be the same one.
     let (ok, _, err) = bsa(&[
         "budget",
@@ -754,13 +771,19 @@ fn budget_errors_name_the_flag_to_change() {
         "0",
         "--timing-tol",
         "0",
+        "--position-tol",
+        "0",
+        "--orientation-tol",
+        "0",
+        "--spin-floor-tol",
+        "0",
         "--cd-tol",
         "0",
         "-q",
     ]);
     assert!(
         !ok && err.contains(
-            "error: --speed-tol, --direction-tol, --spin-tol, --timing-tol, --cd-tol are all 0"
+            "error: --speed-tol, --direction-tol, --spin-tol, --timing-tol, --position-tol, --orientation-tol, --spin-floor-tol, --cd-tol are all 0"
         ),
         "{err}"
     );

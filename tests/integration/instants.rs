@@ -198,8 +198,14 @@ fn bad_positions_and_robust_options_are_refused() {
                 "0",
                 "--timing-tol",
                 "0",
+                "--position-tol",
+                "0",
+                "--orientation-tol",
+                "0",
+                "--spin-floor-tol",
+                "0",
             ],
-            "--speed-tol, --direction-tol, --spin-tol, --timing-tol are all 0",
+            "--speed-tol, --direction-tol, --spin-tol, --timing-tol, --position-tol, --orientation-tol, --spin-floor-tol are all 0",
         ),
         (
             vec![
@@ -213,10 +219,16 @@ fn bad_positions_and_robust_options_are_refused() {
                 "0",
                 "--timing-tol",
                 "0",
+                "--position-tol",
+                "0",
+                "--orientation-tol",
+                "0",
+                "--spin-floor-tol",
+                "0",
                 "--cd-tol",
                 "0",
             ],
-            "--speed-tol, --direction-tol, --spin-tol, --timing-tol, --cd-tol are all 0",
+            "--speed-tol, --direction-tol, --spin-tol, --timing-tol, --position-tol, --orientation-tol, --spin-floor-tol, --cd-tol are all 0",
         ),
     ] {
         let out = tmpdir("robust-bad");

@@ -595,3 +595,81 @@ fn eval_of_a_launch_table_points_to_render() {
         "{err}"
     );
 }
+
+#[test]
+fn new_for_a_launcher_keeps_a_shorter_hop_that_reads_more_often_and_writes_its_frontier() {
+    let dir = tmpdir("new-launcher").into_child("mickey");
+    let target = root().join("scenes/mickey/target.png");
+    let args = |extra: &[&str]| -> Vec<String> {
+        let mut a: Vec<String> = ["new", dir.to_str().unwrap(), "--target"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        a.push(target.to_str().unwrap().to_string());
+        a.extend(["--objects", "sphere:0.6,sphere:0.35*2", "--width", "4"].map(String::from));
+        a.extend(extra.iter().map(|s| s.to_string()));
+        a
+    };
+    // A launcher file with a misspelt field is refused before any design, naming it.
+    let bad = dir.with_file_name("bad-launcher.json");
+    std::fs::write(&bad, r#"{"speed": 0.5}"#).unwrap();
+    let a = args(&["--launcher", bad.to_str().unwrap()]);
+    let (ok, _, err) = bsa(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(
+        !ok && err.contains("bad-launcher.json") && err.contains("unknown field `speed`"),
+        "{err}"
+    );
+    let a = args(&["--launcher"]);
+    let (ok, out, err) = bsa(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(ok, "{err}");
+    let line = out
+        .lines()
+        .find(|l| l.contains("for the launcher, kept the design at t = "))
+        .unwrap_or_else(|| panic!("{out}"));
+    let number_after = |text: &str, key: &str| -> f64 {
+        let rest = &text[text.find(key).unwrap_or_else(|| panic!("{key}: {text}")) + key.len()..];
+        rest.split([' ', ',', '%']).next().unwrap().parse().unwrap()
+    };
+    // Mickey's balls reach their poses at any instant: a shorter hop misses by less.
+    let t = number_after(line, "at t = ");
+    assert!(t < 1.2, "{line}");
+    let kept = number_after(line, "IoU - 0.05) ");
+    let standard = number_after(line, "(the standard design: IoU ");
+    assert!(standard > 0.99, "{line}");
+    let standard_p = number_after(&line[line.find("standard design").unwrap()..], ", ");
+    assert!(kept > standard_p, "{line}");
+    // The frontier beside the scene, and the launcher in it.
+    for f in [
+        "frontier.md",
+        "frontier.csv",
+        "frontier.png",
+        "frontier.svg",
+        "scene.json",
+    ] {
+        assert!(dir.join(f).exists(), "{f}");
+    }
+    let scene: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
+    assert_eq!(scene["launcher"]["direction_deg"], 0.25);
+    assert_eq!(scene["t"].as_f64(), Some(t));
+    let md = std::fs::read_to_string(dir.join("frontier.md")).unwrap();
+    assert_eq!(md.matches("**kept**").count(), 1, "{md}");
+    assert!(
+        md.contains("| 1.2 | at rest, spun |") && md.contains("| in its pose |"),
+        "{md}"
+    );
+    // The solve's report says what launcher it needs and shows the frontier.
+    let out_dir = dir.with_file_name("mickey-out");
+    let (ok, solved, err) = bsa(&[
+        "solve",
+        dir.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(ok && solved.contains("launcher it needs"), "{err}");
+    let page = std::fs::read_to_string(out_dir.join("report.html")).unwrap();
+    assert!(
+        page.contains("What launcher it needs")
+            && page.contains("The designs tried for the launcher")
+    );
+}

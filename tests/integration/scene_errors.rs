@@ -279,3 +279,18 @@ fn a_weight_out_of_range_states_the_range_weights_take() {
     let d = variant("hintweight", |v| v["hints"][0]["weight"] = 1e13.into());
     assert_rejected(&d, &["hints[0].weight", "from 0 to 1e12", "1e13"]);
 }
+
+#[test]
+fn a_scene_launcher_out_of_range_or_misspelt_is_refused_naming_its_field() {
+    let d = variant("launcher-range", |v| {
+        v["launcher"] = serde_json::json!({"orientation_deg": 90.0})
+    });
+    assert_rejected(
+        &d,
+        &["scene.json", "launcher", "orientation tolerance", "45"],
+    );
+    let d = variant("launcher-field", |v| {
+        v["launcher"] = serde_json::json!({"orientation": 0.5})
+    });
+    assert_rejected(&d, &["scene.json", "unknown field `orientation`"]);
+}

@@ -107,6 +107,10 @@ impl Validator<'_> {
                 ),
             ));
         }
+        let launcher = raw.launcher.unwrap_or_default();
+        launcher
+            .validate(t)
+            .map_err(|e| self.field_err("launcher", e.to_string()))?;
         Ok(Scene {
             name,
             source: self.file.to_path_buf(),
@@ -127,6 +131,7 @@ impl Validator<'_> {
             strategy,
             seed: raw.seed.unwrap_or(1),
             contacts,
+            launcher,
         })
     }
 

@@ -1,6 +1,6 @@
 //! Composing a scene from a picture and a box of objects: the design search of
 //! `bsa new` ([`Search::run`]), the picture designed under every
-//! [`Setting`] (each of [`CEILINGS`] in each of [`ORDERS`]), each design made
+//! [`Setting`] (each of [`crate::design::CEILINGS`] in each of [`ORDERS`]), each design made
 //! contact-free ([`separate`]); the designs that differ from those before them then
 //! race ([`race`]) and the best ([`Variant::better_than`]) is kept ([`Found`]). When no
 //! design's solve reaches [`REPLACE_BELOW`], a second round designs every setting again
@@ -24,12 +24,15 @@ use serde_json::Value;
 
 use crate::design::launch::{Geometry, Plan};
 use crate::design::picture::Picture;
-use crate::design::{self, separate, DesignError, Order, Request, CEILINGS, ORDERS, REPLACE_BELOW};
+use crate::design::{self, separate, DesignError, Order, Request, ORDERS, REPLACE_BELOW};
 use crate::energy::Weights;
 use crate::evaluate::Problem;
 use crate::optimize::solver::{self, Schedule, Silent, SolveOptions};
 use crate::output::solution::Solution;
+use crate::scene::launcher::Tolerances;
 use crate::scene::Scene;
+
+pub mod tolerant;
 
 /// Why a design of the search failed.
 #[derive(Debug, thiserror::Error)]
@@ -48,21 +51,22 @@ pub enum SearchError {
 #[derive(Clone, Copy, Debug)]
 pub struct Setting {
     pub order: Order,
-    /// The highest flight at `t`, as a share of the light's height ([`CEILINGS`]).
+    /// The highest flight at `t`, as a share of the light's height ([`crate::design::CEILINGS`]).
     pub ceiling: f64,
     /// Every object placed anew after the exchanges
     /// ([`crate::design::cover::Cover::replace`]).
     pub replace: bool,
 }
 
-/// Every setting of the search, orders outermost: first as greedy, exchanged and
-/// polished; then, in the second round, with every object placed anew too.
-pub fn settings() -> Vec<Setting> {
+/// Every setting of a search under `ceilings`, orders outermost: first as greedy,
+/// exchanged and polished; then, in the second round, with every object placed anew
+/// too.
+pub fn settings(ceilings: &[f64]) -> Vec<Setting> {
     [false, true]
         .into_iter()
         .flat_map(|replace| {
             ORDERS.iter().flat_map(move |&order| {
-                CEILINGS.iter().map(move |&ceiling| Setting {
+                ceilings.iter().map(move |&ceiling| Setting {
                     order,
                     ceiling,
                     replace,
@@ -71,9 +75,6 @@ pub fn settings() -> Vec<Setting> {
         })
         .collect()
 }
-
-/// The settings of the first round.
-const FIRST_ROUND: usize = ORDERS.len() * CEILINGS.len();
 
 /// Where a design's trial solve ended.
 #[derive(Clone, Copy, Debug)]
@@ -84,6 +85,11 @@ pub struct Solved {
     pub clear: bool,
     /// The stages it ran, of all: fewer for a design the race left behind.
     pub stages: (usize, usize),
+    /// The highest point of any body's flight up to `t` above the receiver (m).
+    pub height: f64,
+    /// At the search's launcher, when it has one: `P(IoU >= iou - NEEDS_MARGIN)` and
+    /// the largest factor on its errors that keeps that at 90 %.
+    pub at_launcher: Option<(f64, f64)>,
 }
 
 impl Solved {
@@ -166,14 +172,23 @@ pub struct Search<'a> {
     pub seed: u64,
     /// Whether each design is trial-solved (else they rank by their start guesses).
     pub trial: bool,
+    /// The highest flights tried, as shares of the light's height ([`crate::design::CEILINGS`] by
+    /// default).
+    pub ceilings: &'a [f64],
+    /// The launcher each trial solve is measured at, if any ([`tolerant`]).
+    pub launcher: Option<Tolerances>,
 }
 
-/// What the search found: the best design, the first error (when no design was made)
-/// and every setting's trial, in the order of [`settings`].
+/// What the search found: the best design, the others, the first error (when no design
+/// was made) and every setting's trial, in the order of [`settings`].
 pub struct Found {
     pub best: Option<Variant>,
+    /// Every other design made, in the order of [`settings`] (repeats left out).
+    pub others: Vec<Variant>,
     pub first_error: Option<SearchError>,
     pub trials: Vec<Trial>,
+    /// The ceilings searched.
+    pub ceilings: Vec<f64>,
 }
 
 impl Search<'_> {
@@ -181,13 +196,14 @@ impl Search<'_> {
     /// trial reaches [`REPLACE_BELOW`], the second round too; keep the best of all.
     /// After an interrupt the designs not begun fail with [`SearchError::Interrupted`].
     pub fn run(&self, watch: &dyn Watch, interrupts: &AtomicUsize) -> Found {
-        let settings = settings();
+        let settings = settings(self.ceilings);
+        let first_round = ORDERS.len() * self.ceilings.len();
         let mut designed = Vec::new();
         let mut same_as = Vec::new();
         let round = |ks, designed: &mut _, same_as: &mut _| {
             self.round(&settings, ks, designed, same_as, watch, interrupts)
         };
-        round(0..FIRST_ROUND, &mut designed, &mut same_as);
+        round(0..first_round, &mut designed, &mut same_as);
         let best_trial = designed
             .iter()
             .filter_map(|v| v.as_ref().ok()?.solved)
@@ -195,12 +211,14 @@ impl Search<'_> {
             .map(|s| s.iou)
             .fold(f64::NEG_INFINITY, f64::max);
         if self.trial && best_trial < REPLACE_BELOW && interrupts.load(Ordering::SeqCst) == 0 {
-            round(FIRST_ROUND..settings.len(), &mut designed, &mut same_as);
+            round(first_round..settings.len(), &mut designed, &mut same_as);
         }
         let mut found = Found {
             best: None,
+            others: Vec::new(),
             first_error: None,
             trials: Vec::new(),
+            ceilings: self.ceilings.to_vec(),
         };
         for (v, same) in designed.into_iter().zip(same_as) {
             match v {
@@ -210,7 +228,11 @@ impl Search<'_> {
                         None => Trial::Solved(v.solved),
                     });
                     if found.best.as_ref().is_none_or(|b| v.better_than(b)) {
-                        found.best = Some(v);
+                        if let Some(b) = found.best.replace(v) {
+                            found.others.push(b);
+                        }
+                    } else if same.is_none() {
+                        found.others.push(v);
                     }
                 }
                 Err(e) => {
@@ -238,9 +260,13 @@ impl Search<'_> {
         watch.begin(
             ks.len() as u64,
             &format!(
-                "{}: designing under {} ceilings and {} orders{}",
+                "{}: designing{} under {} ceilings and {} orders{}",
                 self.name,
-                CEILINGS.len(),
+                match self.launcher {
+                    Some(_) => format!(" for t = {} s", self.geometry.t),
+                    None => String::new(),
+                },
+                self.ceilings.len(),
                 ORDERS.len(),
                 if replace { ", objects placed anew" } else { "" }
             ),
@@ -289,7 +315,8 @@ impl Search<'_> {
             }
         }
         // A solve begun stops at once on an interrupt: its solver watches the counter.
-        for (k, s) in race(entrants, self.name, watch, interrupts) {
+        let launcher = self.launcher.as_ref();
+        for (k, s) in race(entrants, self.name, launcher, watch, interrupts) {
             designed[k].as_mut().expect("a raced design").solved = Some(s);
         }
     }
@@ -366,6 +393,7 @@ pub const RUNGS: [f64; 1] = [1.0];
 pub fn race(
     mut entrants: Vec<(usize, Problem)>,
     name: &str,
+    launcher: Option<&Tolerances>,
     watch: &dyn Watch,
     interrupts: &AtomicUsize,
 ) -> Vec<(usize, Solved)> {
@@ -377,7 +405,7 @@ pub fn race(
             false => format!("solving {} designs", entrants.len()),
         };
         watch.begin(entrants.len() as u64, &format!("{name}: {what}"));
-        let solved: Vec<Solution> = entrants
+        let solved: Vec<(Solution, Option<(f64, f64)>)> = entrants
             .par_iter()
             .zip(reached.par_iter_mut())
             .map(|((_, problem), from)| {
@@ -390,10 +418,13 @@ pub fn race(
                     ..SolveOptions::default()
                 };
                 let (s, _) = solver::solve(problem, &options, &mut Silent, interrupts);
+                let p = launcher.map(|tol| tolerant::measure(problem, &s, tol));
                 watch.step();
-                s
+                (s, p)
             })
             .collect();
+        let (solved, at_launcher): (Vec<Solution>, Vec<Option<(f64, f64)>>) =
+            solved.into_iter().unzip();
         watch.end();
         let mut order: Vec<usize> = (0..entrants.len()).collect();
         let key = |s: &Solution| (s.n_contacts == 0, s.iou);
@@ -423,6 +454,8 @@ pub fn race(
                         iou: s.iou,
                         clear: s.n_contacts == 0,
                         stages: (s.stages_completed, s.stages_total),
+                        height: tolerant::highest_flight(&problem, &s.parameters()),
+                        at_launcher: at_launcher[j],
                     },
                 ));
             }
@@ -443,14 +476,14 @@ impl Found {
     /// was made on (a trial that ended with a contact says so; "same" is a design that
     /// an earlier one made too). The second round only when it ran.
     pub fn trials_line(&self, kept: Setting) -> String {
-        let ceilings: Vec<String> = CEILINGS.iter().map(|c| format!("{c}")).collect();
+        let ceilings: Vec<String> = self.ceilings.iter().map(|c| format!("{c}")).collect();
         let per_round: Vec<String> = self
             .trials
-            .chunks(FIRST_ROUND)
+            .chunks(ORDERS.len() * self.ceilings.len())
             .map(|round| {
                 let per_order: Vec<String> = ORDERS
                     .iter()
-                    .zip(round.chunks(CEILINGS.len()))
+                    .zip(round.chunks(self.ceilings.len()))
                     .map(|(order, trials)| {
                         let ious: Vec<String> = trials.iter().map(trial_text).collect();
                         format!("{} ({})", ious.join(" / "), order.label())

@@ -22,7 +22,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use anyhow::{bail, Context, Result};
 use serde_json::{json, Value};
 
-use crate::compose::{self, Scenes, Search, SearchError, Solved, Variant, Watch};
+use crate::compose::{self, tolerant, Search, SearchError, Solved, Variant};
 use crate::design::inventory::{Auto, AutoKind, Inventory, Kind};
 use crate::design::launch::{Geometry, Object, Plan};
 use crate::design::picture::Picture;
@@ -31,15 +31,18 @@ use crate::design::{self, chess, AutoObject, DesignError, Request};
 use crate::energy::Weights;
 use crate::evaluate::Problem;
 use crate::output::files;
+use crate::scene::launcher::Tolerances;
 use crate::scene::{Contacts, Scene, SceneError};
 
 use super::guard::NothingWritten;
 use super::plant::Design;
 use super::scratch::Scratch;
-use super::{load, progress, NewArgs};
+use super::{load, NewArgs};
 
 /// Ctrl-C presses (and SIGTERMs) during `bsa new`: the trial solves stop at once, and
 /// no scene is written.
+mod search;
+
 static INTERRUPTS: AtomicUsize = AtomicUsize::new(0);
 
 /// The scratch copy of the target that the first scene and the designs load.
@@ -55,6 +58,8 @@ pub(super) struct Options {
     seed: u64,
     stage: Stage,
     choose_by: ChooseBy,
+    /// `--launcher`: design for it, with the file it was read from (if any).
+    launcher: Option<(Tolerances, Option<PathBuf>)>,
 }
 
 /// How `bsa new` chooses among its designs (one per ceiling and order).
@@ -69,6 +74,14 @@ pub(super) enum ChooseBy {
 impl Options {
     pub(super) fn new(args: NewArgs) -> Result<Options> {
         let design = Design::new(args.design)?;
+        let launcher = match args.launcher {
+            None => None,
+            Some(None) => Some((Tolerances::default(), None)),
+            Some(Some(f)) => Some((super::launcher::read(&f, design.stage.t)?, Some(f))),
+        };
+        if launcher.is_some() && args.choose_by == ChooseBy::Start {
+            bail!("--launcher measures every design's solve at the launcher: it needs --choose-by solve");
+        }
         Ok(Options {
             dir: args.dir,
             target: args.target,
@@ -76,6 +89,7 @@ impl Options {
             seed: design.seed,
             stage: design.stage,
             choose_by: args.choose_by,
+            launcher,
         })
     }
 }
@@ -253,7 +267,10 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let created = !dir.exists();
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let probe_file = dir.join(SCRATCH_PROBE);
-    let design_files: Vec<PathBuf> = (0..compose::settings().len())
+    let most_settings = compose::settings(&design::CEILINGS)
+        .len()
+        .max(compose::settings(&tolerant::LAUNCHER_CEILINGS).len());
+    let design_files: Vec<PathBuf> = (0..most_settings)
         .map(|k| dir.join(format!(".bsa-new-design-{k}.json")))
         .collect();
     let scratch = Scratch::new(
@@ -304,32 +321,33 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     // scene (mesh paths are relative to the folder) and made contact-free; then, by
     // default, the designs that differ race, and the best is kept.
     let trial = opts.choose_by == ChooseBy::Solve;
-    let mut found = Search {
+    let search = Search {
         picture: &picture,
         geometry: &geometry,
         request: &request,
-        scenes: &DesignFiles(&design_files),
+        scenes: &search::DesignFiles(&design_files),
         name: &name,
         target: SCRATCH_TARGET,
         seed: opts.seed,
         trial,
-    }
-    .run(&Bars::default(), &INTERRUPTS);
+        ceilings: &design::CEILINGS,
+        launcher: None,
+    };
+    let (kept, frontier, trials) = search::run(&search, opts.launcher.as_ref().map(|l| l.0));
     if INTERRUPTS.load(Ordering::SeqCst) > 0 {
         return Err(NothingWritten {
             dir: dir.display().to_string(),
         }
         .into());
     }
-    let Some(Variant {
+    let Ok(Variant {
         plan,
         moves,
         solved,
-        setting,
         ..
-    }) = found.best.take()
+    }) = kept
     else {
-        let err = match found.first_error.take() {
+        let err = match kept.err().flatten() {
             Some(SearchError::Design(e)) => e.into(),
             Some(SearchError::Scenes(e)) => anyhow::Error::from_boxed(e),
             Some(e) => e.into(),
@@ -340,13 +358,17 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     // The folder's scene is replaced only now, target first: a scene.json is never left
     // beside a target it was not made for.
     files::write_atomic(&dir.join("target.png"), &bytes)?;
-    write(
-        &scene_file,
-        &plan.scene_json(&name, "target.png", opts.seed),
-    )?;
+    let mut json = plan.scene_json(&name, "target.png", opts.seed);
+    if let Some((tol, _)) = &opts.launcher {
+        json["launcher"] = serde_json::to_value(tol)?;
+    }
+    write(&scene_file, &json)?;
     scratch.written();
-    if trial {
-        println!("{name}: {}", found.trials_line(setting));
+    if let Some(line) = trials.filter(|_| trial) {
+        println!("{name}: {line}");
+    }
+    if let Some(f) = &frontier {
+        search::write_frontier(dir, &name, f)?;
     }
     // What the user gets: the scene as written, loaded afresh.
     tell_written(opts, &name, &plan, moves, solved)
@@ -396,6 +418,7 @@ fn picture_and_geometry(scene: &Scene) -> (Picture, Geometry) {
         gravity: scene.gravity,
         t: scene.t,
         ceiling: design::CEILINGS[0],
+        posed: false,
     };
     (picture, geometry)
 }
@@ -462,38 +485,6 @@ fn tell_written(
         eprintln!("{name}: note: {note}");
     }
     Ok(())
-}
-
-/// The design search's scene files, one per setting, beside the scene.
-struct DesignFiles<'a>(&'a [PathBuf]);
-
-impl Scenes for DesignFiles<'_> {
-    fn load(&self, k: usize, json: &Value) -> Result<Scene, SearchError> {
-        let text = serde_json::to_string_pretty(json).expect("a JSON value serialises");
-        files::write_atomic(&self.0[k], text.as_bytes())
-            .map_err(|e| SearchError::Scenes(Box::new(e)))?;
-        crate::scene::load(&self.0[k]).map_err(|e| SearchError::Scenes(Box::new(e)))
-    }
-}
-
-/// The search's phases as progress bars, one at a time.
-#[derive(Default)]
-struct Bars(std::sync::Mutex<Option<indicatif::ProgressBar>>);
-
-impl Watch for Bars {
-    fn begin(&self, total: u64, what: &str) {
-        *self.0.lock().expect("no panic holds the bar") = Some(progress::steps(total, what));
-    }
-    fn step(&self) {
-        if let Some(bar) = &*self.0.lock().expect("no panic holds the bar") {
-            bar.inc(1);
-        }
-    }
-    fn end(&self) {
-        if let Some(bar) = self.0.lock().expect("no panic holds the bar").take() {
-            bar.finish_and_clear();
-        }
-    }
 }
 
 /// Share of the target the start guess leaves bare (0 to 1) from which, with a final
