@@ -394,7 +394,7 @@ struct NewArgs {
     #[arg(long, value_enum, default_value_t = new::ChooseBy::Solve)]
     choose_by: new::ChooseBy,
     /// Design for a launcher: besides the standard design, designs at shorter instants
-    /// (t, t/2, t/4) under lower ceilings, each body launched already in its pose at t
+    /// (t/2, t/4, t/8) under lower ceilings, each body launched already in its pose at t
     /// and without spin; every trial solve is measured at the launcher (the defaults, or
     /// FILE.json as `bsa budget --launcher` reads it), and the design kept is the one most
     /// likely to read among those within 0.03 of the best IoU. Writes the frontier of

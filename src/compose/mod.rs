@@ -177,6 +177,9 @@ pub struct Search<'a> {
     pub ceilings: &'a [f64],
     /// The launcher each trial solve is measured at, if any ([`tolerant`]).
     pub launcher: Option<Tolerances>,
+    /// The most rounds of designs: 2 lets a second round place every object anew when
+    /// the first reaches too little ([`REPLACE_BELOW`]).
+    pub rounds: usize,
 }
 
 /// What the search found: the best design, the others, the first error (when no design
@@ -210,7 +213,8 @@ impl Search<'_> {
             .filter(|s| s.clear && s.finished())
             .map(|s| s.iou)
             .fold(f64::NEG_INFINITY, f64::max);
-        if self.trial && best_trial < REPLACE_BELOW && interrupts.load(Ordering::SeqCst) == 0 {
+        let second = self.rounds >= 2 && self.trial && best_trial < REPLACE_BELOW;
+        if second && interrupts.load(Ordering::SeqCst) == 0 {
             round(first_round..settings.len(), &mut designed, &mut same_as);
         }
         let mut found = Found {

@@ -332,6 +332,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         trial,
         ceilings: &design::CEILINGS,
         launcher: None,
+        rounds: 2,
     };
     let (kept, frontier, trials) = search::run(&search, opts.launcher.as_ref().map(|l| l.0));
     if INTERRUPTS.load(Ordering::SeqCst) > 0 {
