@@ -453,7 +453,7 @@ impl BudgetReport {
             let _ = writeln!(
                 s,
                 "| {} | {}{:.4} {} |",
-                p.parameter,
+                p.parameter.replace('_', " "),
                 if p.at_limit { ">= " } else { "" },
                 p.largest,
                 p.unit
