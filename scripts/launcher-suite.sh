@@ -2,7 +2,8 @@
 # Designs a launcher can hit, measured: for the four examples' pictures with their objects
 # (and any set of test pictures), `bsa new --launcher`, `bsa solve`, then `bsa budget` twice
 # (P(IoU >= 0.9), and P(IoU >= IoU - 0.05) with the tolerance search). One row per picture
-# is appended to results/launcher.csv:
+# is appended to results/launcher/suite.csv (a folder of its own: its columns are not the
+# ledger's of results/*.csv):
 #
 #     bash scripts/launcher-suite.sh [SET]     # SET: also the pictures of tools/test-pictures/set-SET
 #
@@ -53,7 +54,7 @@ row = {
 }
 print(" ".join(f"{k}={v}" for k, v in row.items()))
 if ledger != "0":
-    path = "results/launcher.csv"
+    path = "results/launcher/suite.csv"
     new = not os.path.exists(path)
     with open(path, "a", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(row))
