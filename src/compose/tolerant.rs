@@ -1,7 +1,7 @@
 //! Designs a launcher can hit (`bsa new --launcher`): the design search of [`Search`]
 //! run at shorter instants ([`INSTANTS`]) with every body launched already in its pose
 //! at `t` and without spin, beside the standard design; every trial solve measured at
-//! the launcher ([`probability`]) and at the height of its flights
+//! the launcher ([`measure`]) and at the height of its flights
 //! ([`highest_flight`]); the design kept by [`Frontier::choose`].
 //!
 //! A launcher's errors move a body at `t` by about its speed times `t` times the error

@@ -1,7 +1,7 @@
 //! Plots drawn with `plotters`, each as a PNG image and an SVG document from the same
 //! drawing code: the convergence plot (the paper's Figure 7), and the error budget's
 //! IoU histogram and tolerance grid, and the frontier of `bsa new --launcher`
-//! ([`frontier`]).
+//! ([`frontier()`]).
 //!
 //! Every plot keeps its legend outside the data area, so that no curve hides behind it,
 //! and gives each series its own colour (and the terms past the first five a dashed
