@@ -343,7 +343,7 @@ fn bad_input_gets_clear_errors() {
             "{msg}"
         );
         assert!(
-            msg.contains(PARAMETERS[k].0) && msg.contains("tolerance"),
+            msg.contains(&PARAMETERS[k].0.replace('_', " ")) && msg.contains("tolerance"),
             "{msg}"
         );
     }
