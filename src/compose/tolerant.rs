@@ -31,9 +31,11 @@ use crate::scene::Launch;
 /// halving of `t` relaxed it by about a third.
 pub const INSTANTS: [f64; 3] = [0.5, 0.25, 0.125];
 /// The highest flights tried with posed launches, as shares of the light's height:
-/// lower than [`CEILINGS`], since a body's miss grows with the length of its flight
-/// (0.2 is the lowest a design takes).
-pub const LAUNCHER_CEILINGS: [f64; 4] = [0.6, 0.45, 0.3, 0.2];
+/// lower than [`CEILINGS`], since a body's miss grows with the length of its flight.
+/// Each of these was kept for some of the four examples and the three pictures of set
+/// 25; 0.2 was tried too and dropped: it was kept for none, and leaving its designs
+/// out changed no choice.
+pub const LAUNCHER_CEILINGS: [f64; 3] = [0.6, 0.45, 0.3];
 /// How much IoU a design may give up for tolerance: within 0.03 of the best design.
 pub const IOU_ALLOWANCE: f64 = 0.03;
 /// Draws per design of [`measure`]'s probability: one standard error is 1.9 points at
