@@ -43,6 +43,7 @@ use crate::energy::{self, Weights};
 use crate::evaluate::{Problem, Workspace, MAX_THREADS, MAX_TURN};
 use crate::geometry::shape::Shape;
 use crate::output::solution::{check_solution, MismatchError, Solution};
+use crate::scene::launcher::limits;
 use crate::scene::Launch;
 use crate::sim::drag::{self, BodyDrag, DragConfig, DragError};
 use crate::sim::flight::{FreeFlight, LaunchState};
@@ -56,7 +57,7 @@ mod search;
 
 pub use montecarlo::*;
 pub use report::*;
-pub use search::{launcher_scale, needs, probability};
+pub use search::{at_launcher, needs};
 use search::{search, sensitivities};
 
 /// The default IoU a shadow must reach to "read" as the picture

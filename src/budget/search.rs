@@ -128,17 +128,7 @@ fn largest_each(
     pool: &rayon::ThreadPool,
     progress: &dyn Progress,
 ) -> Largest {
-    let t = b.problem.scene.t;
-    let limits: Vec<f64> = PARAMETERS
-        .iter()
-        .map(|(name, _, max)| {
-            if *name == "timing" {
-                max.min(t * 1000.0 / 3.0)
-            } else {
-                *max
-            }
-        })
-        .collect();
+    let limits = limits(b.problem.scene.t);
     let ok = |tol: &Tolerances| b.reaches(comp, tol, m, seed, threshold, pool);
     let start = start.to_array();
     let single = kinds
@@ -204,17 +194,13 @@ pub(super) fn search(
         .into_iter()
         .zip(PARAMETERS)
         .enumerate()
-        .map(|(p, ((best, at_limit), (name, unit, limit)))| {
+        .map(|(p, ((best, at_limit), (name, unit, _)))| {
             let top = if best > 0.0 {
                 2.0 * best
             } else {
                 2.0 * start.to_array()[p]
             };
-            let top = top.min(if name == "timing" {
-                limit.min(b.problem.scene.t * 1000.0 / 3.0)
-            } else {
-                limit
-            });
+            let top = top.min(limits(b.problem.scene.t)[p]);
             let curve = (0..CURVE_POINTS)
                 .map(|j| {
                     let size = top * j as f64 / (CURVE_POINTS - 1) as f64;
@@ -296,36 +282,22 @@ pub fn needs(
     })
 }
 
-/// `P(IoU >= IoU - NEEDS_MARGIN)` of launch `params` at the launcher `tol` over `samples`
-/// draws from `seed`, in a vacuum, on the calling thread (callers run several side by
-/// side), with the solution's IoU.
-pub fn probability(
+/// Launch `params` at the launcher `tol`, in a vacuum, on the calling thread (callers run
+/// several side by side): `P(IoU >= IoU - NEEDS_MARGIN)` over `samples` draws from
+/// `seed`, and the largest factor on the launcher's errors that keeps it at
+/// `PROBABILITY_TARGET` over `scale_samples` draws per try (0 when even a perfect
+/// launcher is not enough).
+pub fn at_launcher(
     problem: &Problem,
     params: &[f64],
     tol: &Tolerances,
-    samples: usize,
-    seed: u64,
+    (samples, scale_samples, seed): (usize, usize, u64),
 ) -> Result<(f64, f64), BudgetError> {
     let b = Budget::vacuum(problem, params)?;
     let threshold = b.vacuum_iou - NEEDS_MARGIN;
-    let (ious, diverged) = b.monte_carlo(params, tol, samples, seed, &thread_pool(Some(1)), &());
-    let stats = IouStats::new(&ious, diverged, threshold);
-    Ok((stats.p_iou_at_least_threshold, b.vacuum_iou))
-}
-
-/// The largest factor on the launcher `tol` that keeps `P(IoU >= IoU - NEEDS_MARGIN) >=
-/// PROBABILITY_TARGET` for launch `params` over `samples` draws from `seed`, in a vacuum,
-/// on the calling thread (as [`probability`]); 0 when even a perfect launcher is not
-/// enough.
-pub fn launcher_scale(
-    problem: &Problem,
-    params: &[f64],
-    tol: &Tolerances,
-    samples: usize,
-    seed: u64,
-) -> Result<f64, BudgetError> {
-    let b = Budget::vacuum(problem, params)?;
-    let threshold = b.vacuum_iou - NEEDS_MARGIN;
+    let pool = thread_pool(Some(1));
+    let (ious, diverged) = b.monte_carlo(params, tol, samples, seed, &pool, &());
+    let p = IouStats::new(&ious, diverged, threshold).p_iou_at_least_threshold;
     let base = Tolerances {
         cd_pct: 0.0,
         ..*tol
@@ -334,9 +306,9 @@ pub fn launcher_scale(
         &b,
         params,
         (0..0, &base, &base),
-        (samples, seed, threshold),
-        &thread_pool(Some(1)),
+        (scale_samples, seed, threshold),
+        &pool,
         &(),
     );
-    Ok(scale)
+    Ok((p, scale))
 }

@@ -179,10 +179,8 @@ pub fn plot_data(name: &str, f: &Frontier) -> FrontierData {
 /// launcher's errors that keeps it at 90 % (over half as many draws per try); zeros
 /// when it cannot be measured.
 pub fn measure(problem: &Problem, s: &Solution, tol: &Tolerances) -> (f64, f64) {
-    let params = s.parameters();
-    let p = budget::probability(problem, &params, tol, SAMPLES, SEED).map_or(0.0, |(p, _)| p);
-    let scale = budget::launcher_scale(problem, &params, tol, SAMPLES / 2, SEED).unwrap_or(0.0);
-    (p, scale)
+    budget::at_launcher(problem, &s.parameters(), tol, (SAMPLES, SAMPLES / 2, SEED))
+        .unwrap_or((0.0, 0.0))
 }
 
 /// The highest point any launched body's centre of mass reaches up to `t` (m above the

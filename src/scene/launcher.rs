@@ -120,16 +120,20 @@ pub struct ToleranceError {
     pub max: f64,
 }
 
+/// The largest tolerance of each kind accepted for a picture at `t`, in the order of
+/// [`Tolerances::to_array`]: [`PARAMETERS`]' limits, the timing's also a third of `t`.
+pub fn limits(t: f64) -> [f64; KINDS] {
+    PARAMETERS.map(|(name, _, max)| match name {
+        "timing" => max.min(t * 1000.0 / 3.0),
+        _ => max,
+    })
+}
+
 impl Tolerances {
-    /// Every tolerance finite and within `[0, limit]` ([`PARAMETERS`]); the timing also
-    /// below a third of `t`.
+    /// Every tolerance finite and within its [`limits`].
     pub fn validate(&self, t: f64) -> Result<(), ToleranceError> {
-        for (value, (name, unit, max)) in self.to_array().into_iter().zip(PARAMETERS) {
-            let max = if name == "timing" {
-                max.min(t * 1000.0 / 3.0)
-            } else {
-                max
-            };
+        let values = self.to_array().into_iter().zip(limits(t));
+        for ((value, max), (name, unit, _)) in values.zip(PARAMETERS) {
             if !(value.is_finite() && (0.0..=max).contains(&value)) {
                 return Err(ToleranceError {
                     name,

@@ -6,7 +6,9 @@
 use std::path::Path;
 use std::process::Command;
 
-use crate::util::{bsa, quick_solve, read_json, root, shared_quick_solve, solve, tmpdir, variant};
+use crate::util::{
+    bsa, quick_solve, read_json, root, shared_quick_solve, solve, tmpdir, variant, zero_tolerances,
+};
 
 #[test]
 fn check_accepts_mickey() {
@@ -760,33 +762,9 @@ fn budget_errors_name_the_flag_to_change() {
         "{err}"
     );
     // No launch error at all: every Monte Carlo launch would be the same one.
-    let (ok, _, err) = bsa(&[
-        "budget",
-        dir,
-        "--speed-tol",
-        "0",
-        "--direction-tol",
-        "0",
-        "--spin-tol",
-        "0",
-        "--timing-tol",
-        "0",
-        "--position-tol",
-        "0",
-        "--orientation-tol",
-        "0",
-        "--spin-floor-tol",
-        "0",
-        "--cd-tol",
-        "0",
-        "-q",
-    ]);
-    assert!(
-        !ok && err.contains(
-            "error: --speed-tol, --direction-tol, --spin-tol, --timing-tol, --position-tol, --orientation-tol, --spin-floor-tol, --cd-tol are all 0"
-        ),
-        "{err}"
-    );
+    let (zeros, says) = zero_tolerances(8);
+    let (ok, _, err) = bsa(&[&["budget", dir][..], &zeros, &["-q"]].concat());
+    assert!(!ok && err.contains(&format!("error: {says}")), "{err}");
 }
 
 /// Tiny and huge numbers the user gave read as written (1e-300), in the summary, the

@@ -5,7 +5,9 @@
 use std::path::Path;
 
 use crate::scene_errors::assert_rejected as rejected;
-use crate::util::{bsa, quick_solve, read_json, root, solve, tmpdir, variant, TempDir};
+use crate::util::{
+    bsa, quick_solve, read_json, root, solve, tmpdir, variant, zero_tolerances, TempDir,
+};
 
 /// Mickey's stages cut to a few iterations, so that a solve takes a fraction of a second.
 fn short(v: &mut serde_json::Value) {
@@ -157,6 +159,7 @@ fn bad_positions_and_robust_options_are_refused() {
     rejected(&d, &["positions", "needs a `table`"]);
     let scene = root().join("scenes/mickey");
     let s = scene.to_str().unwrap();
+    let ((zeros, says), (zeros_air, says_air)) = (zero_tolerances(7), zero_tolerances(8));
     for (args, expect) in [
         (vec!["--draws", "8"], "--draws is an option of --robust"),
         (
@@ -187,48 +190,10 @@ fn bad_positions_and_robust_options_are_refused() {
         ),
         // No launch error at all: the robust objective is the plain one. In a vacuum
         // the drag coefficient has none to give.
+        ([&["--robust"][..], &zeros].concat(), says.as_str()),
         (
-            vec![
-                "--robust",
-                "--speed-tol",
-                "0",
-                "--direction-tol",
-                "0",
-                "--spin-tol",
-                "0",
-                "--timing-tol",
-                "0",
-                "--position-tol",
-                "0",
-                "--orientation-tol",
-                "0",
-                "--spin-floor-tol",
-                "0",
-            ],
-            "--speed-tol, --direction-tol, --spin-tol, --timing-tol, --position-tol, --orientation-tol, --spin-floor-tol are all 0",
-        ),
-        (
-            vec![
-                "--robust",
-                "--air",
-                "--speed-tol",
-                "0",
-                "--direction-tol",
-                "0",
-                "--spin-tol",
-                "0",
-                "--timing-tol",
-                "0",
-                "--position-tol",
-                "0",
-                "--orientation-tol",
-                "0",
-                "--spin-floor-tol",
-                "0",
-                "--cd-tol",
-                "0",
-            ],
-            "--speed-tol, --direction-tol, --spin-tol, --timing-tol, --position-tol, --orientation-tol, --spin-floor-tol, --cd-tol are all 0",
+            [&["--robust", "--air"][..], &zeros_air].concat(),
+            says_air.as_str(),
         ),
     ] {
         let out = tmpdir("robust-bad");

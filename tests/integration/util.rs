@@ -382,3 +382,24 @@ pub fn generated(path: &Path, made: &str, what: &str, how: &str) {
         );
     }
 }
+
+/// The launcher's error flags, in the order the CLI names them.
+pub const LAUNCHER_FLAGS: [&str; 8] = [
+    "--speed-tol",
+    "--direction-tol",
+    "--spin-tol",
+    "--timing-tol",
+    "--position-tol",
+    "--orientation-tol",
+    "--spin-floor-tol",
+    "--cd-tol",
+];
+
+/// The first `n` of [`LAUNCHER_FLAGS`], each set to 0, and the error that refuses them.
+pub fn zero_tolerances(n: usize) -> (Vec<&'static str>, String) {
+    let args = LAUNCHER_FLAGS[..n].iter().flat_map(|f| [*f, "0"]).collect();
+    (
+        args,
+        format!("{} are all 0", LAUNCHER_FLAGS[..n].join(", ")),
+    )
+}
