@@ -59,6 +59,74 @@ fn same_seed_gives_bit_identical_solution_with_1_and_2_threads() {
     assert_ne!(ra, rc);
 }
 
+/// Counts what an observer is told: stages started and finished, in the first attempt
+/// and in later ones, and the attempts started.
+#[derive(Default, Debug, PartialEq)]
+struct Told {
+    started: usize,
+    finished: usize,
+    later_finished: usize,
+    attempts: Vec<(usize, u64)>,
+}
+impl Observer for Told {
+    fn stage_started(&mut self, _index: usize, _stage: &bsa::scene::Stage) {
+        self.started += 1;
+    }
+    fn stage_finished(&mut self, _s: &Solution, _r: &[SampleRecord]) {
+        self.finished += 1;
+    }
+    fn attempt_started(&mut self, attempt: usize, _attempts: usize, _kept: &Solution, seed: u64) {
+        self.attempts.push((attempt, seed));
+    }
+    fn attempt_stage_finished(&mut self, _s: &Solution) {
+        self.later_finished += 1;
+    }
+}
+
+#[test]
+fn attempts_run_ahead_give_the_bits_and_progress_of_attempts_one_after_another() {
+    let mut p = small_mickey(8);
+    // Every attempt ends below the restart IoU, so that each later one is wanted.
+    for s in &mut p.scene.stages {
+        s.restart_iou = 1.0;
+    }
+    let none = AtomicUsize::new(0);
+    let run = |threads| {
+        let opts = SolveOptions {
+            threads: Some(threads),
+            seed: Some(11),
+            resume: None,
+            schedule: Schedule::DEFAULT.with_attempts(3),
+            time_limit: None,
+            until_stage: None,
+        };
+        let mut told = Told::default();
+        let (s, records) = solver::solve(&p, &opts, &mut told, &none);
+        (s, records, told)
+    };
+    // One thread runs the attempts one after another; two run the next one ahead.
+    let (a, ra, told_a) = run(1);
+    let (b, rb, told_b) = run(2);
+    assert_eq!(a.attempts.len(), 3);
+    assert_eq!(params_bits(&a), params_bits(&b));
+    assert_eq!(ra, rb);
+    let seen = |s: &Solution| -> Vec<(u64, u64, usize, bool)> {
+        s.attempts
+            .iter()
+            .map(|t| (t.seed, t.iou.to_bits(), t.samples, t.kept))
+            .collect()
+    };
+    assert_eq!(seen(&a), seen(&b));
+    assert_eq!(a.samples, b.samples);
+    assert_eq!(told_a, told_b);
+    let stages = p.scene.stages.len();
+    assert_eq!(told_b.started, 3 * stages);
+    assert_eq!(
+        (told_b.finished, told_b.later_finished),
+        (stages, 2 * stages)
+    );
+}
+
 /// Raises the interrupt counter twice once the first stage is done: the solve must stop
 /// and hand back a solution with one completed stage.
 struct StopAfterFirstStage<'a>(&'a AtomicUsize);

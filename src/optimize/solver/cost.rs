@@ -88,10 +88,16 @@ pub fn estimate(problem: &Problem, schedule: &Schedule, threads: usize) -> Cost 
     let one = seconds / threads.max(1) as f64 * (1.0 + refine_time);
     let record = std::mem::size_of::<SampleRecord>().max(8 * (TERM_COUNT + 3));
     let workspace = problem.workspace_bytes();
+    // A later attempt runs ahead on a pool of its own (`solver::ahead`).
+    let pools = if threads > 1 && schedule.attempts > 1 {
+        2
+    } else {
+        1
+    };
     Cost {
         samples: samples.ceil() as usize,
         seconds: (EARLY * one, (1.0 + MOVES_TIME) * one * attempts),
-        bytes: (threads.max(1) + 2) * workspace + samples as usize * record,
+        bytes: (pools * threads.max(1) + 2) * workspace + samples as usize * record,
     }
 }
 

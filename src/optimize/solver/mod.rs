@@ -7,7 +7,8 @@
 //! holds, with a [`PassRecord`] for every pass that ran) and [`SampleRecord`] (one row
 //! of `convergence.csv`).
 //!
-//! Data flow of [`solve`]: attempts ([`Schedule::attempts`]) of [`attempt`]; an
+//! Data flow of [`solve`]: attempts ([`Schedule::attempts`]) of [`attempt`], the next
+//! one run ahead at the lowest priority while one runs (`ahead`); an
 //! attempt runs each stage (a scheduled stage, or one occluder of the sequential
 //! strategy, then the final joint stage) from the best launch of the previous one,
 //! the others held fixed, through the schedule's passes (`stage`): moves, CMA-ES runs
@@ -23,6 +24,7 @@
 //! interrupt ends the current stage (the next one starts from its best); a second one
 //! stops the solve, which still returns the best so far.
 
+mod ahead;
 pub mod cost;
 mod refine;
 pub mod schedule;
@@ -32,6 +34,7 @@ mod stage;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
+use ahead::Ahead;
 pub use schedule::Schedule;
 use search::{stop_name, Pool};
 use stage::{StageEnd, StageRun};
@@ -140,57 +143,92 @@ pub fn solve(
     let seed = options.seed.unwrap_or(scene.seed);
     let started = Instant::now();
     let deadline = options.time_limit.map(|limit| started + limit);
-    let (mut kept, mut records) =
-        attempt(problem, options, (seed, 0, deadline), observer, interrupts);
-    let target = scene.stages.last().map_or(1.0, |s| s.restart_iou);
-    let mut tried = vec![attempt_record(&kept, true)];
-    let mut iterations = kept.iterations;
+    let threads = options
+        .threads
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+
+    let attempts = options.schedule.attempts.max(1);
+    // The next attempt runs ahead of the one under way where a core is spare for it and
+    // it could be wanted (a robust solve's never is).
+    let ahead = threads > 1 && problem.plan.robust.is_none();
+    let pool = Pool::new(problem, threads.max(1));
+    let pool_ahead = ahead.then(|| Pool::background(problem, threads));
+    let stops: Vec<AtomicUsize> = (0..attempts).map(|_| AtomicUsize::new(0)).collect();
     let later = SolveOptions {
         resume: None,
         ..options.clone()
     };
-    let attempts = options.schedule.attempts.max(1);
-    let mut passes = kept.passes.clone();
-    for a in 1..attempts {
-        let wanted = kept.complete
-            && kept.iou < target
-            && problem.plan.robust.is_none()
-            && interrupts.load(Ordering::SeqCst) == 0
-            && deadline.is_none_or(|d| Instant::now() < d);
-        if !wanted {
-            break;
-        }
-        let seed_a = attempt_seed(seed, a);
-        observer.attempt_started(a, attempts, &kept, seed_a);
-        let (s, more) = attempt(
+    std::thread::scope(|scope| {
+        let spawn = |a: usize| {
+            let pool = pool_ahead.as_ref().filter(|_| a < attempts)?;
+            let at = (attempt_seed(seed, a), a, deadline);
+            Some(Ahead::spawn(scope, problem, &later, pool, at, &stops[a]))
+        };
+        let mut next = spawn(1);
+        let (mut kept, mut records) = attempt(
             problem,
-            &later,
-            (seed_a, a, deadline),
-            &mut LaterAttempt(&mut *observer),
+            options,
+            &pool,
+            (seed, 0, deadline),
+            observer,
             interrupts,
         );
-        records.extend(more);
-        passes.extend(s.passes.iter().cloned());
-        iterations += s.iterations;
-        let better = s.complete
-            && picture_rank(s.n_contacts, s.iou) < picture_rank(kept.n_contacts, kept.iou);
-        for t in &mut tried {
-            t.kept &= !better;
+        let target = scene.stages.last().map_or(1.0, |s| s.restart_iou);
+        let mut tried = vec![attempt_record(&kept, true)];
+        let mut iterations = kept.iterations;
+        let mut passes = kept.passes.clone();
+        for a in 1..attempts {
+            let wanted = kept.complete
+                && kept.iou < target
+                && problem.plan.robust.is_none()
+                && interrupts.load(Ordering::SeqCst) == 0
+                && deadline.is_none_or(|d| Instant::now() < d);
+            if !wanted {
+                break;
+            }
+            let seed_a = attempt_seed(seed, a);
+            observer.attempt_started(a, attempts, &kept, seed_a);
+            let mut later_observer = LaterAttempt(&mut *observer);
+            let (s, more) = match next.take() {
+                Some(running) => {
+                    next = spawn(a + 1);
+                    running.replay(problem, &mut later_observer, interrupts)
+                }
+                None => attempt(
+                    problem,
+                    &later,
+                    &pool,
+                    (seed_a, a, deadline),
+                    &mut later_observer,
+                    interrupts,
+                ),
+            };
+            records.extend(more);
+            passes.extend(s.passes.iter().cloned());
+            iterations += s.iterations;
+            let better = s.complete
+                && picture_rank(s.n_contacts, s.iou) < picture_rank(kept.n_contacts, kept.iou);
+            for t in &mut tried {
+                t.kept &= !better;
+            }
+            tried.push(attempt_record(&s, better));
+            if better {
+                kept = s;
+            }
         }
-        tried.push(attempt_record(&s, better));
-        if better {
-            kept = s;
+        if let Some(running) = next {
+            running.cancel();
         }
-    }
-    if tried.len() > 1 {
-        kept.samples = tried.iter().map(|t| t.samples).sum();
-        kept.iterations = iterations;
-        kept.wall_time_s = options.resume.as_ref().map_or(0.0, |s| s.wall_time_s)
-            + started.elapsed().as_secs_f64();
-        kept.attempts = tried;
-        kept.passes = passes;
-    }
-    (kept, records)
+        if tried.len() > 1 {
+            kept.samples = tried.iter().map(|t| t.samples).sum();
+            kept.iterations = iterations;
+            kept.wall_time_s = options.resume.as_ref().map_or(0.0, |s| s.wall_time_s)
+                + started.elapsed().as_secs_f64();
+            kept.attempts = tried;
+            kept.passes = passes;
+        }
+        (kept, records)
+    })
 }
 
 /// The order in which attempts' pictures rank: contact-free first, then the higher IoU.
@@ -331,20 +369,13 @@ fn stage_report(stage: &Stage, end: &StageEnd, stopped: bool, started: Instant) 
 fn attempt(
     problem: &Problem,
     options: &SolveOptions,
+    pool: &Pool,
     (seed, a, deadline): (u64, usize, Option<Instant>),
     observer: &mut dyn Observer,
     interrupts: &AtomicUsize,
 ) -> (Solution, Vec<SampleRecord>) {
     let scene = &problem.scene;
-    let threads = options
-        .threads
-        .unwrap_or_else(|| {
-            std::thread::available_parallelism()
-                .map(|n| n.get())
-                .unwrap_or(1)
-        })
-        .max(1);
-    let pool = Pool::new(problem, threads);
+    let threads = pool.threads();
     let start = Instant::now();
     let mut records = Vec::new();
     let Begun {
@@ -383,7 +414,7 @@ fn attempt(
         let held = held_for(problem, &params, stage, &mut unplaced);
         let mut run = StageRun::new(
             problem,
-            &pool,
+            pool,
             k,
             seed,
             one_body,

@@ -21,14 +21,36 @@ pub(super) struct Pool {
 
 impl Pool {
     pub(super) fn new(problem: &Problem, threads: usize) -> Pool {
-        let pool = rayon::ThreadPoolBuilder::new()
+        Pool::build(
+            problem,
+            rayon::ThreadPoolBuilder::new().num_threads(threads),
+        )
+    }
+
+    /// A pool whose workers yield to every other thread of the machine
+    /// ([`lower_priority`]): an attempt run ahead on it takes only the time the attempt
+    /// under way leaves idle.
+    pub(super) fn background(problem: &Problem, threads: usize) -> Pool {
+        let builder = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
+            .start_handler(|_| lower_priority());
+        Pool::build(problem, builder)
+    }
+
+    fn build(problem: &Problem, builder: rayon::ThreadPoolBuilder) -> Pool {
+        let pool = builder
             .build()
             .expect("building a rayon thread pool only fails if threads cannot be spawned");
+        let threads = pool.current_num_threads();
         let workspaces = (0..threads)
             .map(|_| Mutex::new(problem.workspace()))
             .collect();
         Pool { pool, workspaces }
+    }
+
+    /// The worker threads.
+    pub(super) fn threads(&self) -> usize {
+        self.workspaces.len()
     }
 
     /// Evaluate every row of `candidates` (`n` values each, the stage's subset) into `out`;
@@ -59,6 +81,21 @@ impl Pool {
                 },
             );
         });
+    }
+}
+
+/// Lower the calling thread's scheduling priority to the least (Linux: nice 19, this
+/// thread alone), so that it runs on what the machine's other threads leave idle and
+/// at full speed when they wait. Elsewhere it does nothing: the thread competes evenly.
+pub(super) fn lower_priority() {
+    #[cfg(target_os = "linux")]
+    // SAFETY: gettid and setpriority take and return plain integers; setpriority on the
+    // calling thread's own id changes only that thread's weight (a failure leaves it
+    // as it was, which is harmless).
+    unsafe {
+        let tid = libc::syscall(libc::SYS_gettid) as libc::pid_t;
+        let param = libc::sched_param { sched_priority: 0 };
+        libc::sched_setscheduler(tid, libc::SCHED_IDLE, &param);
     }
 }
 

@@ -278,6 +278,57 @@ fn angular_velocity_is_the_derivative_of_orientation() {
 }
 
 #[test]
+fn the_pose_at_t_is_continuous_in_the_spin_across_a_change_of_step_count() {
+    // Coarse steps make the integration error, and so any jump, large. The step count
+    // ceil(t / h) changes where t / h crosses an integer; a grid shrunk to end at t
+    // exactly jumped there by about the error of one step.
+    let mp = brick();
+    let cfg = FlightConfig {
+        rk4_max_step: 1.0,
+        rk4_max_angle: 0.3,
+    };
+    let t = 1.0;
+    let flown = |w: DVec3| {
+        let mut f = FreeFlight::default();
+        f.reset(
+            &mp,
+            LaunchState {
+                origin: DVec3::ZERO,
+                orientation: DQuat::IDENTITY,
+                velocity: DVec3::ZERO,
+                angular_velocity: w,
+            },
+            DVec3::ZERO,
+            t,
+            &cfg,
+        );
+        (f.rk4_steps(), f.orientation(t))
+    };
+    let axis = DVec3::new(-7.0, 15.0, 10.0).normalize();
+    // Bisect on the speed for the change of step count from 40 to 41.
+    let (mut lo, mut hi) = (1.0, 40.0);
+    assert!(flown(axis * lo).0 <= 40 && flown(axis * hi).0 > 40);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if flown(axis * mid).0 <= 40 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let ((n_lo, q_lo), (n_hi, q_hi)) = (flown(axis * lo), flown(axis * hi));
+    assert_eq!((n_lo, n_hi), (40, 41));
+    let jump = angle_between(q_lo, q_hi);
+    assert!(
+        jump < 1e-9,
+        "the pose jumps by {jump} rad where the step count changes"
+    );
+    // The coarse flight is still far off the true one: the test would see a jump.
+    let reference = reference_rotation(&mp, DQuat::IDENTITY, axis * lo, t, 100_000);
+    assert!(angle_between(q_lo, reference) > 1e-5);
+}
+
+#[test]
 fn queries_beyond_t_max_extend_the_integration() {
     let mp = brick();
     let w = DVec3::new(5.0, 8.0, -12.0);
