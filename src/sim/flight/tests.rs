@@ -42,6 +42,26 @@ fn reference_rotation(mp: &MassProperties, q0: DQuat, w0: DVec3, t: f64, steps: 
     DQuat::from_xyzw(s[3], s[4], s[5], s[6]).normalize()
 }
 
+/// A body with mass properties `mp` launched at the origin in `orientation` with spin
+/// `w` and no velocity or gravity, flown to `t_max` with `cfg`.
+fn spun(
+    mp: &MassProperties,
+    orientation: DQuat,
+    w: DVec3,
+    t_max: f64,
+    cfg: &FlightConfig,
+) -> FreeFlight {
+    let mut f = FreeFlight::default();
+    let launch = LaunchState {
+        origin: DVec3::ZERO,
+        orientation,
+        velocity: DVec3::ZERO,
+        angular_velocity: w,
+    };
+    f.reset(mp, launch, DVec3::ZERO, t_max, cfg);
+    f
+}
+
 fn world_inertia(mp: &MassProperties, r: DQuat) -> DMat3 {
     let m = DMat3::from_quat(r);
     m * mp.inertia_tensor() * m.transpose()
@@ -117,19 +137,7 @@ fn torque_free_symmetric_top_matches_closed_form_precession() {
         };
         let q0 = DQuat::from_axis_angle(DVec3::new(0.3, 1.0, -0.2).normalize(), 1.2);
         let w = DVec3::new(6.0, -14.0, 9.0);
-        let mut f = FreeFlight::default();
-        f.reset(
-            &mp,
-            LaunchState {
-                origin: DVec3::ZERO,
-                orientation: q0,
-                velocity: DVec3::ZERO,
-                angular_velocity: w,
-            },
-            DVec3::ZERO,
-            1.5,
-            &FlightConfig::default(),
-        );
+        let f = spun(&mp, q0, w, 1.5, &FlightConfig::default());
         assert_eq!(f.rotation_kind(), RotationKind::Axisymmetric);
         let reference = reference_rotation(&mp, q0, w, 1.5, 150_000);
         let err = angle_between(f.orientation(1.5), reference);
@@ -151,19 +159,7 @@ fn asymmetric_brick_conserves_l_and_energy_and_converges() {
     let q0 = DQuat::from_axis_angle(DVec3::new(1.0, -0.5, 0.3).normalize(), 0.8);
     let w = DVec3::new(11.0, -13.0, 9.0); // |w| ~ 19.3 rad/s
     let cfg = FlightConfig::default();
-    let mut f = FreeFlight::default();
-    f.reset(
-        &mp,
-        LaunchState {
-            origin: DVec3::ZERO,
-            orientation: q0,
-            velocity: DVec3::ZERO,
-            angular_velocity: w,
-        },
-        DVec3::ZERO,
-        2.0,
-        &cfg,
-    );
+    let f = spun(&mp, q0, w, 2.0, &cfg);
     assert_eq!(f.rotation_kind(), RotationKind::Asymmetric);
     let times = grid(2.0, 101);
     let (dl, de) = conservation(&f, &mp, &times);
@@ -175,19 +171,7 @@ fn asymmetric_brick_conserves_l_and_energy_and_converges() {
         rk4_max_step: cfg.rk4_max_step / 10.0,
         rk4_max_angle: cfg.rk4_max_angle / 10.0,
     };
-    let mut fine = FreeFlight::default();
-    fine.reset(
-        &mp,
-        LaunchState {
-            origin: DVec3::ZERO,
-            orientation: q0,
-            velocity: DVec3::ZERO,
-            angular_velocity: w,
-        },
-        DVec3::ZERO,
-        2.0,
-        &fine_cfg,
-    );
+    let fine = spun(&mp, q0, w, 2.0, &fine_cfg);
     let ratio = fine.rk4_steps() as f64 / f.rk4_steps() as f64;
     assert!((ratio - 10.0).abs() < 0.01, "{ratio}");
     let err = times
@@ -221,19 +205,7 @@ fn intermediate_axis_flips_and_still_conserves() {
     // perturbation flips over repeatedly.
     let mp = brick();
     let w = DVec3::new(0.05, 20.0, 0.0);
-    let mut f = FreeFlight::default();
-    f.reset(
-        &mp,
-        LaunchState {
-            origin: DVec3::ZERO,
-            orientation: DQuat::IDENTITY,
-            velocity: DVec3::ZERO,
-            angular_velocity: w,
-        },
-        DVec3::ZERO,
-        2.0,
-        &FlightConfig::default(),
-    );
+    let f = spun(&mp, DQuat::IDENTITY, w, 2.0, &FlightConfig::default());
     let times = grid(2.0, 400);
     let body_wy: Vec<f64> = times
         .iter()
@@ -289,19 +261,7 @@ fn the_pose_at_t_is_continuous_in_the_spin_across_a_change_of_step_count() {
     };
     let t = 1.0;
     let flown = |w: DVec3| {
-        let mut f = FreeFlight::default();
-        f.reset(
-            &mp,
-            LaunchState {
-                origin: DVec3::ZERO,
-                orientation: DQuat::IDENTITY,
-                velocity: DVec3::ZERO,
-                angular_velocity: w,
-            },
-            DVec3::ZERO,
-            t,
-            &cfg,
-        );
+        let f = spun(&mp, DQuat::IDENTITY, w, t, &cfg);
         (f.rk4_steps(), f.orientation(t))
     };
     let axis = DVec3::new(-7.0, 15.0, 10.0).normalize();
@@ -365,19 +325,7 @@ fn queries_beyond_t_max_extend_the_integration() {
     // Negative times integrate backwards: relaunching from the pose and angular
     // velocity at -0.4 s must come back to the launch pose 0.4 s later.
     let (q, wq) = (short.orientation(-0.4), short.angular_velocity(-0.4));
-    let mut back = FreeFlight::default();
-    back.reset(
-        &mp,
-        LaunchState {
-            origin: DVec3::ZERO,
-            orientation: q,
-            velocity: DVec3::ZERO,
-            angular_velocity: wq,
-        },
-        DVec3::ZERO,
-        0.5,
-        &cfg,
-    );
+    let back = spun(&mp, q, wq, 0.5, &cfg);
     let err = angle_between(back.orientation(0.4), DQuat::IDENTITY);
     assert!(err < 1e-8, "{err}");
     assert!(angle_between(q, DQuat::IDENTITY) > 0.5);
