@@ -20,8 +20,10 @@ use super::cover::{to_pixel, Frame, Placement};
 use super::plant::default_strategy;
 use super::pose::{families, lift_at, rest_radius, Family, Pose};
 use crate::geometry::shape::{MassProperties, Shape};
+use crate::scene::velocity_reaching;
 use crate::shadow::raster::ShadowCamera;
-use crate::sim::flight::{FlightConfig, FreeFlight, LaunchState};
+use crate::sim::aim::Spin;
+use crate::sim::flight::{FlightConfig, FreeFlight};
 
 /// An object of the box, ready to be placed.
 #[derive(Clone, Debug)]
@@ -225,7 +227,7 @@ impl Plan {
         let com = mass.local_com;
         let (com0, com_t) = (origin0 + q0 * com, origin_t + q_t * com);
         let t = g.t;
-        let velocity = (com_t - com0 - 0.5 * g.gravity * t * t) / t;
+        let velocity = velocity_reaching(com0, com_t, g.gravity, t);
         let turn = if o.flip { -o.pose.turn } else { o.pose.turn };
         let angular_velocity = match g.posed {
             true => DVec3::ZERO,
@@ -347,54 +349,32 @@ fn ring_slots(cam: &ShadowCamera, rho: f64, pitch: f64, wanted: usize) -> Vec<DV
     out
 }
 
+/// The miss (rad) under which a design's start spin reaches its pose: far below the
+/// solver's own ([`crate::optimize`]'s moves stop at 1e-6), as a start guess is only aimed
+/// once.
+const DESIGN_TOLERANCE: f64 = 1e-9;
+
 /// The launch spin that turns a body from `q0` to `q_t` in `t` seconds of torque-free
-/// flight. `guess` (the turn's angle over `t` about its axis) is exact when that axis is
-/// a principal axis of the body (a box rolled about its long axis, a body of revolution
-/// tipped over); otherwise (a box both rolled and pitched, a knight) the body wobbles
-/// off that axis, and Newton steps on the flown orientation, with a Jacobian of finite
-/// differences, correct the spin until the body arrives in its pose.
+/// flight ([`Spin::reaching`]), from `guess` (the turn's angle over `t` about its axis,
+/// exact when that axis is a principal axis); `guess` itself where Newton's method does
+/// not converge.
 fn spin_to(mass: &MassProperties, q0: DQuat, q_t: DQuat, guess: DVec3, t: f64) -> DVec3 {
-    let cfg = FlightConfig::default();
-    let mut flight = FreeFlight::default();
-    // The rotation (world frame, as a rotation vector) from where spin `w` brings the
-    // body at `t` to where it should be.
-    let mut miss = |w: DVec3| {
-        let launch = LaunchState {
-            origin: DVec3::ZERO,
-            orientation: q0,
-            velocity: DVec3::ZERO,
-            angular_velocity: w,
-        };
-        flight.reset(mass, launch, DVec3::ZERO, t, &cfg);
-        let r = q_t * flight.orientation(t).inverse();
-        if r.w < 0.0 { -r } else { r }.to_scaled_axis()
+    let spin = Spin {
+        mass,
+        from: q0,
+        t,
+        flight: &FlightConfig::default(),
+        tolerance: DESIGN_TOLERANCE,
     };
-    let (mut w, mut e) = (guess, miss(guess));
-    for _ in 0..8 {
-        if !e.is_finite() || e.length() <= 1e-9 {
-            break;
-        }
-        const H: f64 = 1e-6;
-        let cols = [DVec3::X, DVec3::Y, DVec3::Z].map(|d| (miss(w + d * H) - e) / H);
-        let jacobian = glam::DMat3::from_cols(cols[0], cols[1], cols[2]);
-        let det = jacobian.determinant();
-        if !det.is_finite() || det.abs() <= 1e-12 {
-            break;
-        }
-        let next = w - jacobian.inverse() * e;
-        let e_next = miss(next);
-        if !e_next.is_finite() || e_next.length() >= e.length() {
-            break;
-        }
-        (w, e) = (next, e_next);
-    }
-    w
+    spin.reaching(q_t, guess, &mut FreeFlight::default())
+        .unwrap_or(guess)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::shadow::raster::ImageRect;
+    use crate::sim::flight::LaunchState;
 
     fn geometry() -> Geometry {
         let camera = ShadowCamera::new(

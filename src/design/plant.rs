@@ -19,7 +19,7 @@ use super::inventory::{Item, Kind};
 use crate::energy::Weights;
 use crate::evaluate::Problem;
 use crate::geometry::shape::{ObjError, TriMesh};
-use crate::scene::Launch;
+use crate::scene::{velocity_reaching, Launch};
 use crate::shadow::mask::Mask;
 
 /// The stage of a planted (or designed) scene: what `bsa plant` and `bsa new` lay out.
@@ -281,7 +281,7 @@ pub fn draw_launch(problem: &Problem, seed: u64, attempts: usize) -> Result<Vec<
             let s = rng.random_range(0.2..0.5);
             let com_t = on_plane + s * (light - on_plane);
             let com0 = o.launch_com();
-            let v = (com_t - com0 - 0.5 * scene.gravity * t * t) / t;
+            let v = velocity_reaching(com0, com_t, scene.gravity, t);
             let axis = DVec3::new(
                 rng.random_range(-1.0..1.0),
                 rng.random_range(-1.0..1.0),

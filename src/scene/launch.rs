@@ -45,6 +45,12 @@ impl Launch {
     }
 }
 
+/// The launch velocity that puts a centre of mass launched at `from` at `to` after `t`
+/// seconds of flight in a vacuum under `gravity`: `from + v t + gravity t^2 / 2 = to`.
+pub fn velocity_reaching(from: DVec3, to: DVec3, gravity: DVec3, t: f64) -> DVec3 {
+    (to - from - 0.5 * gravity * t * t) / t
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

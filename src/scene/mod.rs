@@ -120,7 +120,7 @@ mod raw;
 mod start;
 mod validate;
 
-pub use launch::Launch;
+pub use launch::{velocity_reaching, Launch};
 pub use raw::at_path;
 use raw::RawScene;
 pub use start::auto_order;

@@ -3,6 +3,7 @@
 
 use glam::{DVec2, DVec3};
 
+use super::launch::velocity_reaching;
 use super::raw::RawScene;
 use super::{Hint, Occluder, Receiver, Table};
 use crate::geometry::distance::{signed_distance, ContactShape};
@@ -79,7 +80,7 @@ impl Aim<'_> {
                 }
             }
             let o = &mut occ[i];
-            let v = (com_t - com0 - 0.5 * gravity * t * t) / t;
+            let v = velocity_reaching(com0, com_t, gravity, t);
             // Absurd hint values can overflow; keep the straight-up start then.
             if v.is_finite() {
                 o.start_velocity = v;
@@ -148,7 +149,7 @@ impl Aim<'_> {
             let want = DVec3::new(want.x, want.y, com0.z);
             if let Some(spot) = free_spot(occ, i, want, table) {
                 let o = &mut occ[i];
-                let v = (now - spot - 0.5 * g * t * t) / t;
+                let v = velocity_reaching(spot, now, g, t);
                 if v.is_finite() {
                     o.position += spot - com0;
                     o.start_velocity = v;

@@ -8,6 +8,7 @@ use glam::{DMat3, DQuat, DVec2, DVec3};
 use super::spin::turn_spin;
 use crate::evaluate::{Problem, Workspace};
 use crate::geometry::shape::Shape;
+use crate::scene::velocity_reaching;
 use crate::scene::Launch;
 use crate::shadow::mask::{Mask, Moments};
 use crate::sim::flight::{FreeFlight, LaunchState};
@@ -205,7 +206,7 @@ pub(super) fn aim(problem: &Problem, params: &mut [f64], i: usize, target: DVec3
     let t = scene.t;
     let start = scene.occluders[i].launch_com();
     let mut launch = Launch::get(params, i);
-    launch.velocity = (target - start - 0.5 * scene.gravity * t * t) / t;
+    launch.velocity = velocity_reaching(start, target, scene.gravity, t);
     launch.set(params, i);
 }
 

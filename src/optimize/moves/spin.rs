@@ -1,15 +1,16 @@
 //! Launch spins that reach an orientation at `t`: [`spin_reaching`] solves for the
-//! spin by Newton's method on the free flight, [`launch_to`] launches a body to a pose
+//! spin ([`crate::sim::aim`]'s Newton's method on the free flight), [`launch_to`] launches a body to a pose
 //! from the slowest spin of a few first guesses ([`spin_guesses`]), [`turn_spin`] turns a body
 //! about a world axis. Adding `angle / t` to a spin is exact only about a principal
 //! axis; a tumbling block needs the solve.
 
-use glam::{DMat3, DQuat, DVec3};
+use glam::{DQuat, DVec3};
 
 use super::aim;
 use crate::evaluate::Problem;
 use crate::scene::Launch;
-use crate::sim::flight::{FlightConfig, FreeFlight, LaunchState};
+use crate::sim::aim::Spin;
+use crate::sim::flight::FreeFlight;
 
 /// Set body `i`'s launch spin in `params` so that its orientation at `t`, `now`, turns by
 /// `rotation` (a world axis and an angle): by adding `angle / t` about the axis to the
@@ -35,29 +36,13 @@ pub(super) fn turn_spin(
     launch.set(params, i);
 }
 
-/// Newton iterations of [`spin_reaching`] on the coarse flight, at most.
-pub(super) const NEWTON_STEPS: usize = 12;
-
-/// Iterations of [`spin_reaching`] on the exact flight, at most, after Newton's method
-/// on the coarse one.
-pub(super) const CHORD_STEPS: usize = 6;
-
-/// Rotation per RK4 step (rad, at the fastest the body's spin may get) of the coarse
-/// flight on which [`spin_reaching`] runs Newton's method: about 1e-4 of the turn's error
-/// at `t`, where the exact flight's steps of 0.02 rad cost five times as much.
-pub(super) const COARSE_ANGLE: f64 = 0.1;
+/// The miss (rad) under which a move's spin reaches its pose: far below a pixel's turn
+/// for any body a picture shows (a 10 cm body turned 1e-6 rad moves its end 0.1 um).
+pub const MOVE_TOLERANCE: f64 = 1e-6;
 
 /// The launch spin that turns body `i` to the orientation `want` at `t` in free flight,
-/// from `guess`; `None` when it does not converge to 1e-6 rad. Adding `angle / t` about
-/// an axis to the spin is exact only for a spin about a principal axis; a tumbling block
-/// needs this to turn where a move asks.
-///
-/// Newton's method (a finite-difference Jacobian, halved steps where a full one does not
-/// get closer) runs on a coarse flight: RK4 on a fixed number of steps set by the guess
-/// ([`COARSE_ANGLE`]), so that the miss is smooth in the spin (the exact flight's step
-/// count follows the spin, and a finite difference across a change of it is noise).
-/// Chord steps with the last Jacobian then bring the exact flight's miss under 1e-6 rad.
-/// For a body with two equal moments both flights are the exact closed form.
+/// from `guess` ([`Spin::reaching`] on the solver's flight, to [`MOVE_TOLERANCE`]);
+/// `None` when it does not converge.
 pub fn spin_reaching(
     problem: &Problem,
     i: usize,
@@ -65,86 +50,15 @@ pub fn spin_reaching(
     guess: DVec3,
     flight: &mut FreeFlight,
 ) -> Option<DVec3> {
-    let scene = &problem.scene;
-    let o = &scene.occluders[i];
-    let t = scene.t;
-    let limit = crate::evaluate::MAX_TURN / t;
-    if !guess.is_finite() || guess.length() > limit {
-        return None;
-    }
-    let k = o.mass.principal_inertia;
-    // The spin's greatest speed in flight is at most |w| I_max / I_min.
-    let turn = guess.length() * k.max_element() / k.min_element() * t;
-    let steps = (turn / COARSE_ANGLE).ceil().max(1.0);
-    let coarse = FlightConfig {
-        rk4_max_step: t / steps,
-        rk4_max_angle: f64::INFINITY,
+    let o = &problem.scene.occluders[i];
+    let spin = Spin {
+        mass: &o.mass,
+        from: o.orientation,
+        t: problem.scene.t,
+        flight: &problem.flight,
+        tolerance: MOVE_TOLERANCE,
     };
-    let mut miss = |w: DVec3, cfg: &FlightConfig| -> DVec3 {
-        let launch = LaunchState {
-            origin: o.position,
-            orientation: o.orientation,
-            velocity: DVec3::ZERO,
-            angular_velocity: w,
-        };
-        flight.reset(&o.mass, launch, scene.gravity, t, cfg);
-        let d = want.conjugate() * flight.orientation(t);
-        if d.w < 0.0 { -d } else { d }.to_scaled_axis()
-    };
-    let mut w = guess;
-    let mut r = miss(w, &coarse);
-    let mut jacobian = None;
-    for _ in 0..NEWTON_STEPS {
-        if !r.is_finite() || w.length() > limit {
-            return None;
-        }
-        // The chord steps need a Jacobian, so a guess that already meets the coarse
-        // flight still gets one below.
-        if r.length() < 1e-6 && jacobian.is_some() {
-            break;
-        }
-        let h = 1e-6 * (1.0 + w.length());
-        let j = DMat3::from_cols(
-            (miss(w + DVec3::X * h, &coarse) - r) / h,
-            (miss(w + DVec3::Y * h, &coarse) - r) / h,
-            (miss(w + DVec3::Z * h, &coarse) - r) / h,
-        );
-        let det = j.determinant();
-        if det.is_nan() || det.abs() <= 1e-12 {
-            return None;
-        }
-        let inverse = j.inverse();
-        jacobian = Some(inverse);
-        if r.length() < 1e-6 {
-            break;
-        }
-        let step = -(inverse * r);
-        let mut lambda = 1.0;
-        loop {
-            let next = w + step * lambda;
-            let rn = miss(next, &coarse);
-            if rn.length() < r.length() {
-                (w, r) = (next, rn);
-                break;
-            }
-            lambda *= 0.5;
-            if lambda < 1.0 / 64.0 {
-                return None;
-            }
-        }
-    }
-    let inverse = jacobian?;
-    for _ in 0..=CHORD_STEPS {
-        let r = miss(w, &problem.flight);
-        if !r.is_finite() || w.length() > limit {
-            return None;
-        }
-        if r.length() < 1e-6 {
-            return Some(w);
-        }
-        w -= inverse * r;
-    }
-    None
+    spin.reaching(want, guess, flight)
 }
 
 /// Launch body `i` in `candidate` so that at `t` its centre of mass is at `com` and its
@@ -223,34 +137,5 @@ mod tests {
             (got - DVec3::Z * (4.0 - std::f64::consts::TAU)).length() < 1e-9,
             "{got}"
         );
-    }
-
-    #[test]
-    fn spin_reaching_finds_the_spin_of_a_tumbling_block() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/fly");
-        let p = Problem::new(crate::scene::load(&dir).unwrap());
-        let mut flight = FreeFlight::default();
-        let o = &p.scene.occluders[0];
-        let t = p.scene.t;
-        // A tumble about no principal axis, several turns long.
-        let w0 = DVec3::new(4.0, -7.0, 11.0);
-        let launch = LaunchState {
-            origin: o.position,
-            orientation: o.orientation,
-            velocity: DVec3::ZERO,
-            angular_velocity: w0,
-        };
-        flight.reset(&o.mass, launch, p.scene.gravity, t, &p.flight);
-        let want = flight.orientation(t);
-        // Where the naive guess (the spin plus a turn over t) lands, Newton corrects it.
-        let guess = w0 + DVec3::new(0.3, 0.2, -0.25);
-        let w = spin_reaching(&p, 0, want, guess, &mut flight).expect("converges");
-        let launch = LaunchState {
-            angular_velocity: w,
-            ..launch
-        };
-        flight.reset(&o.mass, launch, p.scene.gravity, t, &p.flight);
-        let d = want.conjugate() * flight.orientation(t);
-        assert!(d.xyz().length() < 1e-6, "{w} misses by {d}");
     }
 }
