@@ -150,7 +150,7 @@ pub fn solve(
     let attempts = options.schedule.attempts.max(1);
     // The next attempt runs ahead of the one under way where a core is spare for it and
     // it could be wanted (a robust solve's never is).
-    let ahead = threads > 1 && problem.plan.robust.is_none();
+    let ahead = threads > 1 && attempts > 1 && problem.plan.robust.is_none();
     let pool = Pool::new(problem, threads.max(1));
     let pool_ahead = ahead.then(|| Pool::background(problem, threads));
     let stops: Vec<AtomicUsize> = (0..attempts).map(|_| AtomicUsize::new(0)).collect();
