@@ -1,20 +1,26 @@
-//! Attempts that run ahead: while one attempt runs, the next runs beside it at the
-//! lowest priority, on a pool of its own ([`Ahead::spawn`], `Pool::background`), its
-//! progress queued by a [`Relay`]. If the solve wants that
-//! attempt, [`Ahead::replay`] hands its progress to the observer as if it ran then;
-//! if not, [`Ahead::cancel`] stops it.
+//! An attempt that runs ahead: while the first attempt runs, the second runs beside it
+//! in the idle scheduling class, on a pool of its own ([`Ahead::spawn`], [`Idle`]), its
+//! progress queued by a [`Relay`]. If the solve wants that attempt, [`Ahead::replay`]
+//! raises its threads back to the normal class and hands its progress to the observer
+//! as if it ran then. Where the system refuses (an unprivileged process may not leave
+//! the idle class, and on a busy machine the attempt would starve), the attempt is
+//! stopped and resumed in the normal class from its last finished stage
+//! ([`Ahead::take_over`]). If the solve does not want it, [`Ahead::cancel`] stops it.
 //!
 //! Why: an attempt's moves, CMA-ES updates and one-body refinements run on one thread,
 //! so one attempt keeps two cores about 1.4 times busy. The attempt ahead takes the idle
-//! time, so a solve of one attempt is not slowed and one of two takes less time. Each attempt's result is a function of its seed alone, so the solve's
-//! result is the same, bit for bit, as when they run one after another.
+//! time, so a solve of one attempt is not slowed and one of two takes less time. Each
+//! attempt's result is a function of its seed alone, and a resumed attempt ends where
+//! it would have, so the solve's result is the same, bit for bit, as when its attempts
+//! run one after another.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
+use std::sync::{Arc, Mutex};
 use std::thread::{Scope, ScopedJoinHandle};
 use std::time::{Duration, Instant};
 
-use super::search::{lower_priority, Pool};
+use super::search::Pool;
 use super::{attempt, IterationInfo, Observer, SolveOptions};
 use crate::evaluate::Problem;
 use crate::output::solution::{SampleRecord, Solution};
@@ -27,6 +33,50 @@ const SHADOW_EVERY: Duration = Duration::from_millis(250);
 
 /// How often the replay looks at the caller's interrupts while it waits for progress.
 const POLL: Duration = Duration::from_millis(50);
+
+/// The threads of an attempt run ahead, by their kernel ids: [`Idle::enter`] puts the
+/// calling thread in the idle scheduling class (it runs only on what the machine's other
+/// threads leave), [`Idle::leave`] raises every thread entered back to the normal one.
+/// Elsewhere than on Linux both do nothing and the threads compete evenly.
+#[derive(Clone, Default)]
+pub(super) struct Idle(Arc<Mutex<Vec<i64>>>);
+
+impl Idle {
+    /// Put the calling thread in the idle class, and remember it.
+    pub(super) fn enter(&self) {
+        #[cfg(target_os = "linux")]
+        // SAFETY: gettid and sched_setscheduler take and return plain integers and a
+        // parameter that outlives the call; on the calling thread's own id they change
+        // only its class (a failure leaves it as it was, which is harmless).
+        unsafe {
+            let tid = libc::syscall(libc::SYS_gettid);
+            let param = libc::sched_param { sched_priority: 0 };
+            if libc::sched_setscheduler(tid as libc::pid_t, libc::SCHED_IDLE, &param) == 0 {
+                self.0.lock().unwrap_or_else(|e| e.into_inner()).push(tid);
+            }
+        }
+    }
+
+    /// Raise every thread entered back to the normal class; `false` where the system
+    /// refuses one (an unprivileged process may not leave the idle class).
+    pub(super) fn leave(&self) -> bool {
+        let ids = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        #[cfg(target_os = "linux")]
+        // SAFETY: as in `enter`, on ids of threads of this process that the pool and
+        // the attempt's thread keep alive while the attempt runs.
+        unsafe {
+            let param = libc::sched_param { sched_priority: 0 };
+            ids.iter().all(|&tid| {
+                libc::sched_setscheduler(tid as libc::pid_t, libc::SCHED_OTHER, &param) == 0
+            })
+        }
+        #[cfg(not(target_os = "linux"))]
+        {
+            let _ = ids;
+            true
+        }
+    }
+}
 
 /// One progress event of an attempt that runs ahead.
 enum Event {
@@ -46,11 +96,16 @@ enum Event {
     StageFinished(Box<Solution>),
 }
 
-/// The observer of an attempt that runs ahead: it queues what it is told.
+/// The observer of an attempt that runs ahead: it queues what it is told, and keeps
+/// its last finished stage's solution.
 struct Relay {
     events: Sender<Event>,
     shadow_sent: Option<Instant>,
+    finished: Finished,
 }
+
+/// The solution of the last stage an attempt finished, as its observer last heard.
+type Finished = Arc<Mutex<Option<Box<Solution>>>>;
 
 impl Relay {
     /// Queue `event`; a replay that stopped listening (a cancelled attempt) is no error.
@@ -86,7 +141,9 @@ impl Observer for Relay {
     }
 
     fn stage_finished(&mut self, solution: &Solution, _records: &[SampleRecord]) {
-        self.send(Event::StageFinished(Box::new(solution.clone())));
+        let s = Box::new(solution.clone());
+        *self.finished.lock().unwrap_or_else(|e| e.into_inner()) = Some(s.clone());
+        self.send(Event::StageFinished(s));
     }
 }
 
@@ -97,24 +154,31 @@ pub(super) struct Ahead<'scope> {
     /// The attempt's own interrupt counter: the caller's interrupts once it is wanted,
     /// 2 (a stop) when it is cancelled.
     stop: &'scope AtomicUsize,
+    idle: &'scope Idle,
+    finished: Finished,
 }
 
 impl<'scope> Ahead<'scope> {
-    /// Start attempt `a` (with `seed`, until `deadline`) on a thread of `scope`.
+    /// Start attempt `a` (with `seed`, until `deadline`) on a thread of `scope` in the
+    /// idle class, on `pool`, whose workers entered `idle`.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn spawn<'env>(
         scope: &'scope Scope<'scope, 'env>,
         problem: &'scope Problem,
         options: &'scope SolveOptions,
-        pool: &'scope Pool,
+        (pool, idle): (&'scope Pool, &'scope Idle),
         (seed, a, deadline): (u64, usize, Option<Instant>),
         stop: &'scope AtomicUsize,
     ) -> Ahead<'scope> {
         let (tx, events) = mpsc::channel();
+        let finished = Finished::default();
+        let heard = finished.clone();
         let handle = scope.spawn(move || {
-            lower_priority();
+            idle.enter();
             let mut relay = Relay {
                 events: tx,
                 shadow_sent: None,
+                finished: heard,
             };
             attempt(
                 problem,
@@ -129,6 +193,8 @@ impl<'scope> Ahead<'scope> {
             handle,
             events,
             stop,
+            idle,
+            finished,
         }
     }
 
@@ -139,14 +205,19 @@ impl<'scope> Ahead<'scope> {
         let _ = self.handle.join();
     }
 
-    /// Hand the attempt's progress, queued and to come, to `observer` until it ends, the
-    /// caller's `interrupts` passed on to it; returns its result.
+    /// Raise the attempt to the normal class and hand its progress, queued and to come,
+    /// to `observer` until it ends, the caller's `interrupts` passed on to it; returns
+    /// its result. Where it cannot be raised, [`Ahead::take_over`] with `resume`.
     pub(super) fn replay(
         self,
         problem: &Problem,
         observer: &mut dyn Observer,
         interrupts: &AtomicUsize,
+        resume: Resume<'_>,
     ) -> (Solution, Vec<SampleRecord>) {
+        if !self.idle.leave() {
+            return self.take_over(problem, observer, resume);
+        }
         let stages = &problem.scene.stages;
         let mut shadow: Option<Mask> = None;
         loop {
@@ -192,9 +263,115 @@ impl<'scope> Ahead<'scope> {
                 }
             }
         }
-        match self.handle.join() {
-            Ok(result) => result,
-            Err(panic) => std::panic::resume_unwind(panic),
+        join(self.handle)
+    }
+
+    /// Stop the attempt, hand the observer its stages, and run it on from its last
+    /// finished stage by `resume` (from the start if it finished none): a resumed attempt
+    /// ends where the attempt would have. Its records are those of its finished stages,
+    /// then the resumed run's.
+    pub(super) fn take_over(
+        self,
+        problem: &Problem,
+        observer: &mut dyn Observer,
+        resume: Resume<'_>,
+    ) -> (Solution, Vec<SampleRecord>) {
+        self.stop.store(2, Ordering::SeqCst);
+        let stages = &problem.scene.stages;
+        for event in self.events.iter() {
+            match event {
+                Event::StageStarted(k) => observer.stage_started(k, &stages[k]),
+                Event::StageFinished(s) => observer.stage_finished(&s, &[]),
+                Event::Iteration { .. } | Event::Restarted(..) => {}
+            }
         }
+        let (ended, mut records) = join(self.handle);
+        if ended.complete {
+            // It ended on its own before the stop.
+            return (ended, records);
+        }
+        let finished = self
+            .finished
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .take();
+        let from = finished.filter(|s| s.stages_completed > 0);
+        let kept: usize = from.as_ref().map_or(0, |s| {
+            s.stages[..s.stages_completed]
+                .iter()
+                .map(|r| r.samples)
+                .sum()
+        });
+        records.truncate(kept);
+        let (s, more) = resume(from.map(|s| *s), observer);
+        records.extend(more);
+        (s, records)
+    }
+}
+
+/// How a solve runs an attempt on in the normal class: from a solution of its finished
+/// stages (or from the start), with an observer.
+pub(super) type Resume<'a> =
+    &'a dyn Fn(Option<Solution>, &mut dyn Observer) -> (Solution, Vec<SampleRecord>);
+
+/// The result of an attempt's thread (its panic passed on).
+fn join(
+    handle: ScopedJoinHandle<'_, (Solution, Vec<SampleRecord>)>,
+) -> (Solution, Vec<SampleRecord>) {
+    match handle.join() {
+        Ok(result) => result,
+        Err(panic) => std::panic::resume_unwind(panic),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optimize::solver::{attempt_seed, Schedule, Silent};
+
+    #[test]
+    fn an_attempt_taken_over_part_way_ends_where_it_would_have_alone() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/mickey");
+        let mut scene = crate::scene::load(&dir).unwrap();
+        for s in &mut scene.stages {
+            s.max_iterations = 8;
+            s.population = 16;
+        }
+        // A long last stage, so that the take-over lands in it.
+        scene.stages.last_mut().unwrap().max_iterations = 400;
+        let problem = Problem::new(scene);
+        let options = SolveOptions {
+            threads: Some(1),
+            seed: Some(5),
+            schedule: Schedule::DEFAULT.with_attempts(2),
+            ..SolveOptions::default()
+        };
+        let pool = Pool::new(&problem, 1);
+        let none = AtomicUsize::new(0);
+        let at = (attempt_seed(5, 1), 1, None);
+        let (alone, alone_records) = attempt(&problem, &options, &pool, at, &mut Silent, &none);
+        let (stop, idle) = (AtomicUsize::new(0), Idle::default());
+        let resumed = std::cell::Cell::new(false);
+        let (taken, records) = std::thread::scope(|scope| {
+            let ahead = Ahead::spawn(scope, &problem, &options, (&pool, &idle), at, &stop);
+            while ahead.finished.lock().unwrap().is_none() {
+                std::thread::sleep(Duration::from_millis(1));
+            }
+            let resume = |from: Option<Solution>, o: &mut dyn Observer| {
+                assert!(from.as_ref().is_some_and(|s| s.stages_completed == 1));
+                resumed.set(true);
+                let options = SolveOptions {
+                    resume: from,
+                    ..options.clone()
+                };
+                attempt(&problem, &options, &pool, at, o, &none)
+            };
+            ahead.take_over(&problem, &mut Silent, &resume)
+        });
+        assert!(resumed.get(), "the attempt ended before the take-over");
+        assert_eq!(taken.parameters(), alone.parameters());
+        assert_eq!(taken.iou.to_bits(), alone.iou.to_bits());
+        assert_eq!(taken.samples, alone.samples);
+        assert_eq!(records, alone_records);
     }
 }

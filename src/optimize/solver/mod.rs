@@ -7,8 +7,8 @@
 //! holds, with a [`PassRecord`] for every pass that ran) and [`SampleRecord`] (one row
 //! of `convergence.csv`).
 //!
-//! Data flow of [`solve`]: attempts ([`Schedule::attempts`]) of [`attempt`], the next
-//! one run ahead at the lowest priority while one runs (`ahead`); an
+//! Data flow of [`solve`]: attempts ([`Schedule::attempts`]) of [`attempt`], the second
+//! run ahead in the idle scheduling class while the first runs (`ahead`); an
 //! attempt runs each stage (a scheduled stage, or one occluder of the sequential
 //! strategy, then the final joint stage) from the best launch of the previous one,
 //! the others held fixed, through the schedule's passes (`stage`): moves, CMA-ES runs
@@ -34,7 +34,7 @@ mod stage;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
-use ahead::Ahead;
+use ahead::{Ahead, Idle};
 pub use schedule::Schedule;
 use search::{stop_name, Pool};
 use stage::{StageEnd, StageRun};
@@ -146,25 +146,42 @@ pub fn solve(
     let threads = options
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-
     let attempts = options.schedule.attempts.max(1);
-    // The next attempt runs ahead of the one under way where a core is spare for it and
-    // it could be wanted (a robust solve's never is).
+    // The second attempt runs ahead of the first where a core is spare for it and it
+    // could be wanted (a robust solve's never is).
     let ahead = threads > 1 && attempts > 1 && problem.plan.robust.is_none();
     let pool = Pool::new(problem, threads.max(1));
-    let pool_ahead = ahead.then(|| Pool::background(problem, threads));
-    let stops: Vec<AtomicUsize> = (0..attempts).map(|_| AtomicUsize::new(0)).collect();
+    let idle = Idle::default();
+    let pool_ahead = ahead.then(|| {
+        let idle = idle.clone();
+        Pool::with_start(problem, threads, move || idle.enter())
+    });
+    let stop_ahead = AtomicUsize::new(0);
     let later = SolveOptions {
         resume: None,
         ..options.clone()
     };
-    std::thread::scope(|scope| {
-        let spawn = |a: usize| {
-            let pool = pool_ahead.as_ref().filter(|_| a < attempts)?;
-            let at = (attempt_seed(seed, a), a, deadline);
-            Some(Ahead::spawn(scope, problem, &later, pool, at, &stops[a]))
+    // Attempt `a` from the start, or resumed from a solution of its finished stages.
+    let run_later = |a: usize, from: Option<Solution>, observer: &mut dyn Observer| {
+        let resumed;
+        let options = match from {
+            Some(s) => {
+                resumed = SolveOptions {
+                    resume: Some(s),
+                    ..later.clone()
+                };
+                &resumed
+            }
+            None => &later,
         };
-        let mut next = spawn(1);
+        let at = (attempt_seed(seed, a), a, deadline);
+        attempt(problem, options, &pool, at, observer, interrupts)
+    };
+    std::thread::scope(|scope| {
+        let mut next = pool_ahead.as_ref().map(|pool_ahead| {
+            let at = (attempt_seed(seed, 1), 1, deadline);
+            Ahead::spawn(scope, problem, &later, (pool_ahead, &idle), at, &stop_ahead)
+        });
         let (mut kept, mut records) = attempt(
             problem,
             options,
@@ -191,17 +208,10 @@ pub fn solve(
             let mut later_observer = LaterAttempt(&mut *observer);
             let (s, more) = match next.take() {
                 Some(running) => {
-                    next = spawn(a + 1);
-                    running.replay(problem, &mut later_observer, interrupts)
+                    let resume = |from, o: &mut dyn Observer| run_later(a, from, o);
+                    running.replay(problem, &mut later_observer, interrupts, &resume)
                 }
-                None => attempt(
-                    problem,
-                    &later,
-                    &pool,
-                    (seed_a, a, deadline),
-                    &mut later_observer,
-                    interrupts,
-                ),
+                None => run_later(a, None, &mut later_observer),
             };
             records.extend(more);
             passes.extend(s.passes.iter().cloned());

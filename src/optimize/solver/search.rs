@@ -27,13 +27,16 @@ impl Pool {
         )
     }
 
-    /// A pool whose workers yield to every other thread of the machine
-    /// ([`lower_priority`]): an attempt run ahead on it takes only the time the attempt
-    /// under way leaves idle.
-    pub(super) fn background(problem: &Problem, threads: usize) -> Pool {
+    /// A pool whose workers each run `on_start` first (the attempt run ahead lowers
+    /// their priority there).
+    pub(super) fn with_start(
+        problem: &Problem,
+        threads: usize,
+        on_start: impl Fn() + Send + Sync + 'static,
+    ) -> Pool {
         let builder = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
-            .start_handler(|_| lower_priority());
+            .start_handler(move |_| on_start());
         Pool::build(problem, builder)
     }
 
@@ -81,21 +84,6 @@ impl Pool {
                 },
             );
         });
-    }
-}
-
-/// Lower the calling thread's scheduling priority to the least (Linux: nice 19, this
-/// thread alone), so that it runs on what the machine's other threads leave idle and
-/// at full speed when they wait. Elsewhere it does nothing: the thread competes evenly.
-pub(super) fn lower_priority() {
-    #[cfg(target_os = "linux")]
-    // SAFETY: gettid and setpriority take and return plain integers; setpriority on the
-    // calling thread's own id changes only that thread's weight (a failure leaves it
-    // as it was, which is harmless).
-    unsafe {
-        let tid = libc::syscall(libc::SYS_gettid) as libc::pid_t;
-        let param = libc::sched_param { sched_priority: 0 };
-        libc::sched_setscheduler(tid, libc::SCHED_IDLE, &param);
     }
 }
 
