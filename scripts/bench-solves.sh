@@ -8,6 +8,7 @@
 # set its wall-time targets on them, before `bsa new` designed the examples) once per
 # seed on all cores (results in /tmp/bsa-bench/<scene>-<seed>/, not in export/) and prints one line
 # per solve: IoU at t, contacts, samples, iterations and the solver's own wall time.
+# SCENES="mickey fly" solves only those (labels as printed, e.g. fly-hand-made).
 # Targets (issue "four examples"): mickey <= 5 s, fly <= 10 s, tbc <= 27 s,
 # thinker <= 4 min on 2 cores. Every solve is also a row of results/bench.csv
 # (scripts/ledger.sh: set_or_seed the seed, item the scene, route solve).
@@ -22,6 +23,7 @@ for dir in scenes/*/ benches/hand-made/*/; do
     [ -f "$dir/scene.json" ] || continue
     name=$(basename "$dir")
     case $dir in benches/*) label=$name-hand-made ;; *) label=$name ;; esac
+    if [ -n "${SCENES:-}" ] && [[ " $SCENES " != *" $label "* ]]; then continue; fi
     for seed in "${seeds[@]}"; do
         out=/tmp/bsa-bench/$label-$seed
         ./target/release/bsa solve "$dir" --seed "$seed" --out "$out" -q --report >"$out.log" 2>&1 ||
