@@ -14,7 +14,7 @@
 //! it would have, so the solve's result is the same, bit for bit, as when its attempts
 //! run one after another.
 
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
 use std::sync::{Arc, Mutex};
 use std::thread::{Scope, ScopedJoinHandle};
@@ -96,12 +96,14 @@ enum Event {
     StageFinished(Box<Solution>),
 }
 
-/// The observer of an attempt that runs ahead: it queues what it is told, and keeps
-/// its last finished stage's solution.
+/// The observer of an attempt that runs ahead: it queues the stages it is told of, and
+/// the iterations once the attempt is replayed (`watched`: before, they would only
+/// pile up, with a shadow each), and keeps its last finished stage's solution.
 struct Relay {
     events: Sender<Event>,
     shadow_sent: Option<Instant>,
     finished: Finished,
+    watched: Arc<AtomicBool>,
 }
 
 /// The solution of the last stage an attempt finished, as its observer last heard.
@@ -120,6 +122,9 @@ impl Observer for Relay {
     }
 
     fn iteration(&mut self, info: &IterationInfo) {
+        if !self.watched.load(Ordering::Relaxed) {
+            return;
+        }
         let due = self.shadow_sent.is_none_or(|t| t.elapsed() >= SHADOW_EVERY);
         if due {
             self.shadow_sent = Some(Instant::now());
@@ -156,6 +161,8 @@ pub(super) struct Ahead<'scope> {
     stop: &'scope AtomicUsize,
     idle: &'scope Idle,
     finished: Finished,
+    /// Whether the attempt is being replayed (its iterations are then queued).
+    watched: Arc<AtomicBool>,
 }
 
 impl<'scope> Ahead<'scope> {
@@ -173,12 +180,15 @@ impl<'scope> Ahead<'scope> {
         let (tx, events) = mpsc::channel();
         let finished = Finished::default();
         let heard = finished.clone();
+        let watched = Arc::new(AtomicBool::new(false));
+        let seen = watched.clone();
         let handle = scope.spawn(move || {
             idle.enter();
             let mut relay = Relay {
                 events: tx,
                 shadow_sent: None,
                 finished: heard,
+                watched: seen,
             };
             attempt(
                 problem,
@@ -195,6 +205,7 @@ impl<'scope> Ahead<'scope> {
             stop,
             idle,
             finished,
+            watched,
         }
     }
 
@@ -218,6 +229,7 @@ impl<'scope> Ahead<'scope> {
         if !self.idle.leave() {
             return self.take_over(problem, observer, resume);
         }
+        self.watched.store(true, Ordering::Relaxed);
         let stages = &problem.scene.stages;
         let mut shadow: Option<Mask> = None;
         loop {
