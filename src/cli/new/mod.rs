@@ -488,10 +488,9 @@ fn tell_written(
     Ok(())
 }
 
-/// Share of the target the start guess leaves bare (0 to 1) from which, with a final
-/// (or start) IoU below [`SHORT_IOU`], the objects are taken to be too few or of the
-/// wrong proportions for the picture.
-const BARE_SHARE: f64 = 0.15;
+/// With more than [`design::BARE_SHARE`] of the target bare at the start, a final (or
+/// start) IoU below this says the objects are too few or of the wrong proportions for
+/// the picture.
 const SHORT_IOU: f64 = 0.9;
 
 /// A note for the user when the box of objects cannot draw the picture: most of what
@@ -500,7 +499,7 @@ const SHORT_IOU: f64 = 0.9;
 /// count stopped (`auto`): at the cap, more objects than it adds; where one more gains
 /// too little, a size that fits the parts left bare.
 fn too_few_objects(missed: f64, iou: f64, auto: Option<design::AutoStop>) -> Option<String> {
-    if missed <= BARE_SHARE || iou >= SHORT_IOU {
+    if missed <= design::BARE_SHARE || iou >= SHORT_IOU {
         return None;
     }
     let advice = match auto {

@@ -179,6 +179,11 @@ impl<'a> Cover<'a> {
         }
     }
 
+    /// Target pixels.
+    pub fn target(&self) -> usize {
+        self.picture.count()
+    }
+
     /// Target pixels not yet covered.
     pub fn open(&self) -> usize {
         self.value.iter().filter(|&&v| v > 0.0).count()
