@@ -331,7 +331,8 @@ fn add_auto(
         if open < AUTO_MIN_RISE * union {
             return AutoStop::Rise(Some(open / union));
         }
-        // A gain raises the IoU (new target over new background beats target over union).
+        // While the target is bare, any gain will do: a gain raises the IoU (new target
+        // over new background beats target over union).
         let bare = open > BARE_SHARE * cover.target() as f64;
         let least = if bare { 0.0 } else { AUTO_MIN_RISE };
         let k = objects.len();
