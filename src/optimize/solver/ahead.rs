@@ -174,8 +174,23 @@ impl<'scope> Ahead<'scope> {
         problem: &'scope Problem,
         options: &'scope SolveOptions,
         (pool, idle): (&'scope Pool, &'scope Idle),
+        at: (u64, usize, Option<Instant>),
+        stop: &'scope AtomicUsize,
+    ) -> Ahead<'scope> {
+        Self::spawn_observed(scope, problem, options, (pool, idle), at, stop, |r| r)
+    }
+
+    /// [`Ahead::spawn`], the attempt observed by `observe(relay)` (tests stop it at a
+    /// chosen point through an observer around the relay).
+    #[allow(clippy::too_many_arguments)]
+    fn spawn_observed<'env, O: Observer + Send + 'scope>(
+        scope: &'scope Scope<'scope, 'env>,
+        problem: &'scope Problem,
+        options: &'scope SolveOptions,
+        (pool, idle): (&'scope Pool, &'scope Idle),
         (seed, a, deadline): (u64, usize, Option<Instant>),
         stop: &'scope AtomicUsize,
+        observe: impl FnOnce(Relay) -> O + Send + 'scope,
     ) -> Ahead<'scope> {
         let (tx, events) = mpsc::channel();
         let finished = Finished::default();
@@ -184,18 +199,18 @@ impl<'scope> Ahead<'scope> {
         let seen = watched.clone();
         let handle = scope.spawn(move || {
             idle.enter();
-            let mut relay = Relay {
+            let mut observer = observe(Relay {
                 events: tx,
                 shadow_sent: None,
                 finished: heard,
                 watched: seen,
-            };
+            });
             attempt(
                 problem,
                 options,
                 pool,
                 (seed, a, deadline),
-                &mut relay,
+                &mut observer,
                 stop,
             )
         });
@@ -341,6 +356,42 @@ mod tests {
     use super::*;
     use crate::optimize::solver::{attempt_seed, Schedule, Silent};
 
+    /// The relay of an attempt run ahead, which stops the attempt (as a take-over
+    /// would) at its `at`-th iteration after stage `stage` starts: where the take-over
+    /// lands does not hang on how the test's thread and the attempt's are scheduled.
+    struct StopAt<'a> {
+        relay: Relay,
+        stop: &'a AtomicUsize,
+        stage: usize,
+        at: usize,
+        /// Iterations since stage `stage` started, once it has.
+        seen: Option<usize>,
+    }
+
+    impl Observer for StopAt<'_> {
+        fn stage_started(&mut self, index: usize, stage: &Stage) {
+            if index == self.stage {
+                self.seen = Some(0);
+            }
+            self.relay.stage_started(index, stage);
+        }
+        fn iteration(&mut self, info: &IterationInfo) {
+            if let Some(seen) = self.seen.as_mut() {
+                *seen += 1;
+                if *seen == self.at {
+                    self.stop.store(2, Ordering::SeqCst);
+                }
+            }
+            self.relay.iteration(info);
+        }
+        fn restarted(&mut self, index: usize, restart: usize, population: usize) {
+            self.relay.restarted(index, restart, population);
+        }
+        fn stage_finished(&mut self, solution: &Solution, records: &[SampleRecord]) {
+            self.relay.stage_finished(solution, records);
+        }
+    }
+
     #[test]
     fn an_attempt_taken_over_part_way_ends_where_it_would_have_alone() {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/mickey");
@@ -349,8 +400,8 @@ mod tests {
             s.max_iterations = 8;
             s.population = 16;
         }
-        // A long last stage, so that the take-over lands in it.
-        scene.stages.last_mut().unwrap().max_iterations = 400;
+        let last = scene.stages.len() - 1;
+        assert!(last > 0, "the take-over must land after a finished stage");
         let problem = Problem::new(scene);
         let options = SolveOptions {
             threads: Some(1),
@@ -365,12 +416,29 @@ mod tests {
         let (stop, idle) = (AtomicUsize::new(0), Idle::default());
         let resumed = std::cell::Cell::new(false);
         let (taken, records) = std::thread::scope(|scope| {
-            let ahead = Ahead::spawn(scope, &problem, &options, (&pool, &idle), at, &stop);
-            while ahead.finished.lock().unwrap().is_none() {
+            // Stopped in the middle of its last stage.
+            let stop_at = |relay| StopAt {
+                relay,
+                stop: &stop,
+                stage: last,
+                at: 3,
+                seen: None,
+            };
+            let ahead = Ahead::spawn_observed(
+                scope,
+                &problem,
+                &options,
+                (&pool, &idle),
+                at,
+                &stop,
+                stop_at,
+            );
+            // The take-over comes once the attempt has been stopped where chosen.
+            while stop.load(Ordering::SeqCst) == 0 {
                 std::thread::sleep(Duration::from_millis(1));
             }
             let resume = |from: Option<Solution>, o: &mut dyn Observer| {
-                assert!(from.as_ref().is_some_and(|s| s.stages_completed == 1));
+                assert!(from.as_ref().is_some_and(|s| s.stages_completed == last));
                 resumed.set(true);
                 let options = SolveOptions {
                     resume: from,
