@@ -13,6 +13,7 @@
 //! `bsa plant` ([`plant`]): problems with a known answer, a random contact-free launch
 //! whose shadow becomes the target.
 
+pub mod advice;
 pub mod assign;
 pub mod chess;
 pub mod cover;
@@ -526,7 +527,7 @@ mod tests {
 
     /// A picture whose pixel (x, y) is on where `on` says, 320 x 240 at 2.5 mm per
     /// pixel under a light 6 m up.
-    fn scene(on: impl Fn(f64, f64) -> bool) -> (Picture, cover::Frame) {
+    pub(super) fn scene(on: impl Fn(f64, f64) -> bool) -> (Picture, cover::Frame) {
         let (w, h) = (320, 240);
         let px = (0..w * h)
             .map(|k| on((k % w) as f64 + 0.5, (k / w) as f64 + 0.5))
@@ -534,7 +535,7 @@ mod tests {
         (Picture::new(w, h, px), cover::Frame::new(0.0025, 6.0, 0.8))
     }
 
-    fn block(x: f64, y: f64, z: f64) -> Object {
+    pub(super) fn block(x: f64, y: f64, z: f64) -> Object {
         Object {
             stem: "box".into(),
             shape: crate::geometry::shape::Shape::Cuboid {

@@ -139,6 +139,37 @@ impl Picture {
         0.5 * (2.0 * cxy).atan2(cxx - cyy)
     }
 
+    /// The share (0 to 1) of the on pixels that no disc of `radius` pixels within the on
+    /// pixels covers (the picture less its opening by that disc): its parts thinner than
+    /// `2 radius`. `d` is [`Picture::distance`]. The discs' centres are the pixels at
+    /// `radius` or more from the background; a pixel is covered when one is within
+    /// `radius` of it, which the transform of a picture that is on everywhere but at the
+    /// centres tells (padded, so that its edge is farther than `radius`).
+    pub fn thin_share(&self, d: &[f32], radius: f64) -> f64 {
+        let on = self.count();
+        if on == 0 {
+            return 0.0;
+        }
+        let pad = radius.ceil() as usize + 1;
+        let (w, h) = (self.width + 2 * pad, self.height + 2 * pad);
+        let mut rest = vec![true; w * h];
+        for y in 0..self.height {
+            for x in 0..self.width {
+                if f64::from(d[y * self.width + x]) >= radius {
+                    rest[(y + pad) * w + x + pad] = false;
+                }
+            }
+        }
+        let near = Picture::new(w, h, rest).distance();
+        let thin = (0..self.width * self.height)
+            .filter(|&k| {
+                let (x, y) = (k % self.width, k / self.width);
+                self.on[k] && f64::from(near[(y + pad) * w + x + pad]) > radius
+            })
+            .count();
+        thin as f64 / on as f64
+    }
+
     /// Centroid of the on pixels (pixel coordinates), if any.
     pub fn centroid(&self) -> Option<DVec2> {
         let (mut n, mut s) = (0usize, DVec2::ZERO);
@@ -192,6 +223,48 @@ fn squared_1d(f: &[f64], out: &mut Vec<f64>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn thin_share_is_the_share_outside_the_opening_by_a_disc() {
+        // A 40 x 40 square with a leg 6 px wide and 60 long below it.
+        let (w, h) = (80, 120);
+        let on: Vec<bool> = (0..w * h)
+            .map(|k| {
+                let (x, y) = (k % w, k / w);
+                (20..60).contains(&x) && (10..50).contains(&y)
+                    || (37..43).contains(&x) && (50..110).contains(&y)
+            })
+            .collect();
+        let pic = Picture::new(w, h, on.clone());
+        let d = pic.distance();
+        let total = pic.count() as f64;
+        // Discs 6 px across fit in the leg: nothing is thin.
+        assert_eq!(pic.thin_share(&d, 3.0), 0.0);
+        // Discs 8 px across fit only in the square: the leg (but for the top, where
+        // discs in the square reach) is thin, and so are the square's corners.
+        let thin = pic.thin_share(&d, 4.0);
+        let leg = 6.0 * 60.0 / total;
+        assert!(
+            thin > 0.9 * leg && thin < leg + 8.0 / total,
+            "{thin} against {leg}"
+        );
+        // Brute force: a pixel is covered when a centre (d >= r) lies within r of it.
+        let r = 4.0f64;
+        let centres: Vec<(f64, f64)> = (0..w * h)
+            .filter(|&k| f64::from(d[k]) >= r)
+            .map(|k| ((k % w) as f64, (k / w) as f64))
+            .collect();
+        let brute = (0..w * h)
+            .filter(|&k| {
+                let (x, y) = ((k % w) as f64, (k / w) as f64);
+                on[k] && !centres.iter().any(|c| (c.0 - x).hypot(c.1 - y) <= r)
+            })
+            .count() as f64
+            / total;
+        assert!((thin - brute).abs() < 1e-12, "{thin} against {brute}");
+        // Wider than the square: all of it is thin.
+        assert_eq!(pic.thin_share(&d, 21.0), 1.0);
+    }
 
     fn bar(w: usize, h: usize, x0: usize, x1: usize, y0: usize, y1: usize) -> Picture {
         let on = (0..w * h)

@@ -488,6 +488,45 @@ fn new_in(cwd: &Path, target: &Path, objects: &str, extra: &[&str]) -> (bool, St
 }
 
 #[test]
+fn new_says_at_what_width_its_objects_can_draw_the_thin_parts() {
+    // A disc 50 px across on six legs 2 px wide and 50 long, a third of the picture, at
+    // 1.6 m over 160 px: legs 2 cm wide, for blocks whose least side (3.5 cm) casts at
+    // least 3.9 cm. Their shadows spill over the legs whatever the solve does.
+    let d = tmpdir("new-thin");
+    let target = d.join("thin.png");
+    picture(&target, 160, 120, |x, y| {
+        let (dx, dy) = (x as i64 - 80, y as i64 - 35);
+        dx * dx + dy * dy <= 625
+            || (60..110).contains(&y)
+                && [40, 60, 70, 90, 100, 120]
+                    .iter()
+                    .any(|&l| (l..l + 2).contains(&x))
+    });
+    let blocks = "box:0.14x0.07x0.035*4";
+    let (ok, _, err) = new_in(&d, &target, blocks, &["--choose-by", "start"]);
+    assert!(ok, "{err}");
+    let thin = "narrower than the narrowest shadow the objects cast (3.9 cm)";
+    assert!(err.contains(thin), "{err}");
+    let width: f64 = err
+        .split("at --width ")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .and_then(|w| w.parse().ok())
+        .unwrap_or_else(|| panic!("no width in: {err}"));
+    assert!(width > 1.6, "{err}");
+    // At that width the legs are as wide as the blocks' shadows.
+    let w = width.to_string();
+    let wider = tmpdir("new-thin-wider");
+    let (ok, _, err) = new_in(
+        &wider,
+        &target,
+        blocks,
+        &["--choose-by", "start", "--width", &w],
+    );
+    assert!(ok && !err.contains("narrower than"), "{err}");
+}
+
+#[test]
 fn new_names_a_missing_mesh_as_typed_and_never_reads_one_beside_the_scene() {
     // The file is missing where the user's path points (the current folder) but there
     // is one of that name inside the output folder: before the fix the scene read that

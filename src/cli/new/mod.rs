@@ -372,7 +372,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         search::write_frontier(dir, &name, f)?;
     }
     // What the user gets: the scene as written, loaded afresh.
-    tell_written(opts, &name, &plan, moves, solved)
+    tell_written(opts, &name, (&plan, moves, solved), &search)
 }
 
 /// The design's request: the list's fixed items as objects (each its prototype's
@@ -426,13 +426,13 @@ fn picture_and_geometry(scene: &Scene) -> (Picture, Geometry) {
 
 /// Tell the user what was written: the scene as written, loaded afresh, its start
 /// guess drawn into `start.png`, a line of what it holds and, when the objects leave
-/// much of the picture bare, a note.
+/// much of the picture bare or in parts too thin for them (the picture and objects that
+/// `drawn` designed from), a note.
 fn tell_written(
     opts: &Options,
     name: &str,
-    plan: &Plan,
-    moves: usize,
-    solved: Option<Solved>,
+    (plan, moves, solved): (&Plan, usize, Option<Solved>),
+    drawn: &Search,
 ) -> Result<()> {
     let dir = &opts.dir;
     let problem = Problem::new(load::scene(dir)?);
@@ -481,36 +481,12 @@ fn tell_written(
     );
     let target = &problem.scene.target;
     let missed = target.and_not_count(&start_picture) as f64 / target.count().max(1) as f64;
-    if let Some(note) = too_few_objects(missed, solved.map_or(start.iou, |s| s.iou), plan.auto_stop)
-    {
+    let iou = solved.map_or(start.iou, |s| s.iou);
+    let thin = || design::advice::thin_parts(drawn.picture, &drawn.geometry.frame(), drawn.request);
+    if let Some(note) = design::advice::note(missed, iou, plan.auto_stop, &thin) {
         eprintln!("{name}: note: {note}");
     }
     Ok(())
-}
-
-/// With more than [`design::BARE_SHARE`] of the target bare at the start, a final (or
-/// start) IoU below this says the objects are too few or of the wrong proportions for
-/// the picture.
-const SHORT_IOU: f64 = 0.9;
-
-/// A note for the user when the box of objects cannot draw the picture: most of what
-/// the start guess misses is target no object's shadow reaches, which no solve can
-/// fill. `None` when the objects suffice. What helps depends on why an automatic
-/// count stopped (`auto`): at the cap, more objects than it adds; where one more gains
-/// too little, a size that fits the parts left bare.
-fn too_few_objects(missed: f64, iou: f64, auto: Option<design::AutoStop>) -> Option<String> {
-    if missed <= design::BARE_SHARE || iou >= SHORT_IOU {
-        return None;
-    }
-    let advice = match auto {
-        None => "more objects, or objects shaped more like its parts (auto:box:XxYxZ, auto:sphere or auto:chess lets bsa new choose how many, and several auto:box items which sizes)",
-        Some(design::AutoStop::Cap) => "more objects than auto: adds (it stops at its cap): list the objects with their counts, or add larger ones",
-        Some(_) => "objects of a size that fits its bare parts (another auto: item of a smaller size)",
-    };
-    Some(format!(
-        "the objects leave {:.0} % of the picture bare at the start, and the design reaches IoU {iou:.3}; the picture may need {advice}",
-        100.0 * missed
-    ))
 }
 
 /// An error of the first scene, which is a scratch file the user never wrote, told in

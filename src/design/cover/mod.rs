@@ -27,6 +27,8 @@ const COARSE_SAMPLES: usize = 120;
 const FINE_SAMPLES: usize = 500;
 /// Placements kept from the coarse search for refinement.
 const KEEP: usize = 6;
+/// The radius (m) of the least ball `auto:sphere` adds.
+pub const LEAST_BALL_M: f64 = 0.005;
 /// Shadows closer than this (m, at the body's height) count as touching.
 pub const NEAR_M: f64 = 0.01;
 
@@ -370,7 +372,7 @@ impl<'a> Cover<'a> {
             let centre = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
             for &m in &prefs {
                 let r = (r_px * p / m * 1000.0).round() / 1000.0;
-                if r < 0.005 {
+                if r < LEAST_BALL_M {
                     continue;
                 }
                 let samples = Outline::Disc { r }.samples(COARSE_SAMPLES);

@@ -589,6 +589,16 @@ impl Shape {
         }
     }
 
+    /// The least of the solid's extents along the body axes (m): the width of the
+    /// narrowest shadow it casts unmagnified, where its narrowest direction is a body
+    /// axis (as for balls, blocks and the chess pieces).
+    pub fn least_width(&self) -> f64 {
+        [DVec3::X, DVec3::Y, DVec3::Z]
+            .map(|a| (self.support(a) - self.support(-a)).dot(a))
+            .into_iter()
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// Largest distance from `about` (body frame) to a point of the solid.
     pub fn bounding_radius(&self, about: DVec3) -> f64 {
         match self {

@@ -1,0 +1,180 @@
+//! What `bsa new` tells the user when the box of objects cannot draw the picture, which
+//! no solve mends ([`note`]): parts of the picture narrower than any of the objects'
+//! shadows ([`thin_parts`], [`ThinParts`]) and a target the objects leave bare.
+
+use super::cover::{Frame, LEAST_BALL_M};
+use super::picture::Picture;
+use super::{AutoObject, AutoStop, Request, BARE_SHARE};
+
+/// The parts of a picture narrower than any shadow a box of objects casts
+/// ([`thin_parts`]): no object draws them without spilling over their sides.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThinParts {
+    /// Share of the target (0 to 1) narrower than the narrowest shadow.
+    pub share: f64,
+    /// The narrowest shadow's width (m): the narrowest object's least width at the
+    /// least magnification the design uses (higher flights cast wider shadows).
+    pub least_width: f64,
+    /// The picture's width (m) at which no more than [`BARE_SHARE`] of the target is
+    /// narrower than that shadow; infinite where even the picture's widest parts are.
+    pub width_needed: f64,
+}
+
+/// How much of `picture` is narrower than the narrowest shadow that the objects of
+/// `request` cast (balls of `auto:sphere` as small as [`LEAST_BALL_M`]), and at what
+/// picture width that share falls to [`BARE_SHARE`]. `None` when the request has no
+/// objects.
+pub fn thin_parts(picture: &Picture, frame: &Frame, request: &Request) -> Option<ThinParts> {
+    let px = frame.metres_per_px;
+    let widths = request
+        .fixed
+        .iter()
+        .chain(request.auto.iter().filter_map(|a| match &a.0 {
+            AutoObject::Given(o) => Some(o),
+            AutoObject::Sphere { .. } => None,
+        }));
+    let mut least = widths.fold(f64::INFINITY, |w, o| {
+        w.min(o.shape.least_width() * frame.m_lo)
+    });
+    if request
+        .auto
+        .iter()
+        .any(|a| matches!(a.0, AutoObject::Sphere { .. }))
+    {
+        least = least.min(2.0 * LEAST_BALL_M * frame.m_lo);
+    }
+    if !least.is_finite() {
+        return None;
+    }
+    let d = picture.distance();
+    let need = least / px / 2.0;
+    let share = picture.thin_share(&d, need);
+    // The largest disc radius (pixels) that leaves at most BARE_SHARE thin, bisected:
+    // the share grows with the radius, and no on pixel is thinner than a pixel.
+    let (mut lo, mut hi) = (0.5, need);
+    if share > BARE_SHARE {
+        for _ in 0..12 {
+            let mid = 0.5 * (lo + hi);
+            if picture.thin_share(&d, mid) <= BARE_SHARE {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+    } else {
+        lo = need;
+    }
+    let width_m = px * picture.width as f64;
+    Some(ThinParts {
+        share,
+        least_width: least,
+        width_needed: if lo > 0.5 {
+            width_m * need / lo
+        } else {
+            f64::INFINITY
+        },
+    })
+}
+
+/// With more than [`BARE_SHARE`] of the target bare at the start, a final (or
+/// start) IoU below this says the objects are too few or of the wrong proportions for
+/// the picture.
+const SHORT_IOU: f64 = 0.9;
+
+/// A note for the user when the box of objects cannot draw the picture, which no solve
+/// mends: much of the picture is narrower than any of the objects' shadows (`thin`, read
+/// only when the IoU is short), or most of what the start guess misses is target no
+/// object's shadow reaches. `None` when the objects suffice. For thin parts, a wider
+/// picture helps, or narrower objects; for bare ones, what helps depends on why an
+/// automatic count stopped (`auto`): at the cap, more objects than it adds; where one
+/// more gains too little, a size that fits the parts left bare.
+pub fn note(
+    missed: f64,
+    iou: f64,
+    auto: Option<AutoStop>,
+    thin: &dyn Fn() -> Option<ThinParts>,
+) -> Option<String> {
+    if iou >= SHORT_IOU {
+        return None;
+    }
+    if let Some(t) = thin().filter(|t| t.share > BARE_SHARE) {
+        let wider = if t.width_needed.is_finite() {
+            format!(
+                "at --width {:.2} or more, all but {:.0} % of it is as wide; or give narrower objects",
+                // Up, so that the width said is enough.
+                (100.0 * t.width_needed).ceil() / 100.0,
+                100.0 * BARE_SHARE
+            )
+        } else {
+            "give narrower objects".to_string()
+        };
+        return Some(format!(
+            "{:.0} % of the picture is narrower than the narrowest shadow the objects cast ({:.1} cm), so their shadows spill over its sides or leave it bare (the design reaches IoU {iou:.3}); {wider}",
+            100.0 * t.share,
+            100.0 * t.least_width
+        ));
+    }
+    if missed <= BARE_SHARE {
+        return None;
+    }
+    let advice = match auto {
+        None => "more objects, or objects shaped more like its parts (auto:box:XxYxZ, auto:sphere or auto:chess lets bsa new choose how many, and several auto:box items which sizes)",
+        Some(AutoStop::Cap) => "more objects than auto: adds (it stops at its cap): list the objects with their counts, or add larger ones",
+        Some(_) => "objects of a size that fits its bare parts (another auto: item of a smaller size)",
+    };
+    Some(format!(
+        "the objects leave {:.0} % of the picture bare at the start, and the design reaches IoU {iou:.3}; the picture may need {advice}",
+        100.0 * missed
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::design::tests::{block, scene};
+
+    #[test]
+    fn thin_parts_are_those_narrower_than_the_narrowest_shadow_and_a_wider_picture_widens_them() {
+        // The body and legs 6 px wide of the test above, a fifth of the target.
+        let leg = |x: f64, y: f64| {
+            (140.0..230.0).contains(&y)
+                && [60.0, 100.0, 140.0, 180.0]
+                    .iter()
+                    .any(|&l| (l..l + 6.0).contains(&x))
+        };
+        let (pic, frame) = scene(|x, y| (x - 124.0).hypot(y - 90.0) <= 50.0 || leg(x, y));
+        let blocks = |least: f64| Request {
+            fixed: vec![block(0.14, 0.07, least)],
+            auto: vec![(AutoObject::Given(block(0.07, 0.07, 0.07)), 3)],
+        };
+        // The narrowest shadow is 4 px across: the legs are as wide.
+        let narrow = blocks(4.0 * frame.metres_per_px / frame.m_lo);
+        let t = thin_parts(&pic, &frame, &narrow).unwrap();
+        assert!(t.share < 0.02, "{t:?}");
+        assert_eq!(t.width_needed, frame.metres_per_px * pic.width as f64);
+        // 10 px across: the legs are thin, and at the width the note gives they are not.
+        let wide = blocks(10.0 * frame.metres_per_px / frame.m_lo);
+        let t = thin_parts(&pic, &frame, &wide).unwrap();
+        assert!(t.share > BARE_SHARE, "{t:?}");
+        let scale = t.width_needed / (frame.metres_per_px * pic.width as f64);
+        assert!(scale > 1.0 && scale < 10.0 / 6.0 + 0.1, "{t:?}");
+        let wider = Frame {
+            metres_per_px: frame.metres_per_px * scale,
+            ..frame
+        };
+        let at = thin_parts(&pic, &wider, &wide).unwrap();
+        assert!(at.share <= BARE_SHARE, "{at:?}");
+        // Balls may be as small as the least ball.
+        let balls = Request {
+            fixed: Vec::new(),
+            auto: vec![(AutoObject::Sphere { density: 705.0 }, usize::MAX)],
+        };
+        let t = thin_parts(&pic, &frame, &balls).unwrap();
+        assert_eq!(t.least_width, 2.0 * LEAST_BALL_M * frame.m_lo);
+        let none = Request {
+            fixed: Vec::new(),
+            auto: Vec::new(),
+        };
+        assert_eq!(thin_parts(&pic, &frame, &none), None);
+    }
+}
