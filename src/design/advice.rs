@@ -118,9 +118,9 @@ pub fn note(
         return None;
     }
     let advice = match auto {
-        None => "more objects, or objects shaped more like its parts (auto:box:XxYxZ, auto:sphere or auto:chess lets bsa new choose how many, and several auto:box items which sizes)",
-        Some(AutoStop::Cap) => "more objects than auto: adds (it stops at its cap): list the objects with their counts, or add larger ones",
-        Some(_) => "objects of a size that fits its bare parts (another auto: item of a smaller size)",
+        None => "more objects, or objects shaped more like its parts (auto:box:XxYxZ, auto:sphere or auto:chess lets bsa new choose how many, and several auto:box items which sizes)".to_string(),
+        Some(AutoStop::Cap(n)) => format!("more objects than auto: adds (it stops at its cap of {n}): a count above it on the auto: item (such as auto:sphere*{}) raises the cap, each object adding to the solve's time", 2 * n),
+        Some(_) => "objects of a size that fits its bare parts (another auto: item of a smaller size)".to_string(),
     };
     Some(format!(
         "the objects leave {:.0} % of the picture bare at the start, and the design reaches IoU {iou:.3}; the picture may need {advice}",

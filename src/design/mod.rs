@@ -280,8 +280,9 @@ pub enum AutoStop {
     /// less than [`AUTO_MIN_RISE`], or by nothing where the target is bare
     /// ([`BARE_SHARE`]); `None`: no object of the kinds left has a place.
     Rise(Option<f64>),
-    /// It reached [`AUTO_CAP`] objects.
-    Cap,
+    /// It reached its cap of this many objects ([`AUTO_CAP`], or more where the list
+    /// allows more).
+    Cap(usize),
     /// Every kind reached the number the list allows of it.
     Used,
 }
@@ -300,7 +301,7 @@ impl std::fmt::Display for AutoStop {
                 "one more would raise the design's IoU by {r:.4}, less than {AUTO_MIN_RISE}"
             ),
             AutoStop::Rise(None) => write!(f, "no more objects of the kind have a place"),
-            AutoStop::Cap => write!(f, "it reached the cap of {AUTO_CAP} objects"),
+            AutoStop::Cap(n) => write!(f, "it reached the cap of {n} objects"),
             AutoStop::Used => write!(f, "the list allows no more of any kind"),
         }
     }
@@ -322,7 +323,11 @@ fn add_auto(
     auto: &[(AutoObject, usize)],
 ) -> AutoStop {
     let mut left: Vec<usize> = auto.iter().map(|x| x.1).collect();
-    for _ in 0..AUTO_CAP {
+    // A list that allows more than the cap, kind by kind, raises it: its author takes
+    // the time of the solve of that many.
+    let stated = left.iter().filter(|&&n| n != usize::MAX).sum::<usize>();
+    let cap = AUTO_CAP.max(stated);
+    for _ in 0..cap {
         if left.iter().all(|&n| n == 0) {
             return AutoStop::Used;
         }
@@ -366,7 +371,10 @@ fn add_auto(
         objects.push(o);
         cover.commit(p, family);
     }
-    AutoStop::Cap
+    if left.iter().all(|&n| n == 0) {
+        return AutoStop::Used;
+    }
+    AutoStop::Cap(cap)
 }
 
 /// Why object `k` has no place.
@@ -589,11 +597,30 @@ mod tests {
         let stop = add_auto(&mut cover, &mut objects, &auto);
         let bare = cover.open() as f64 / pic.count() as f64;
         assert!(
-            bare <= BARE_SHARE || stop == AutoStop::Cap,
+            bare <= BARE_SHARE || stop == AutoStop::Cap(AUTO_CAP),
             "{stop:?} at {} balls, {:.0} % bare",
             objects.len(),
             100.0 * bare
         );
+    }
+
+    #[test]
+    fn an_automatic_count_stops_at_the_cap_unless_the_list_allows_more() {
+        // Fifty dots 12 px across, 30 px apart: each takes a ball of its own.
+        let (pic, frame) = scene(|x, y| {
+            let (i, j) = ((x / 30.0).floor(), (y / 30.0).floor());
+            i < 10.0 && j < 5.0 && (x - 30.0 * i - 15.0).hypot(y - 30.0 * j - 15.0) <= 6.0
+        });
+        let count = |most: usize| {
+            let mut cover = Cover::new(&pic, frame);
+            let mut objects = Vec::new();
+            let auto = [(AutoObject::Sphere { density: 705.0 }, most)];
+            let stop = add_auto(&mut cover, &mut objects, &auto);
+            (objects.len(), stop)
+        };
+        assert_eq!(count(usize::MAX), (AUTO_CAP, AutoStop::Cap(AUTO_CAP)));
+        assert_eq!(count(40), (40, AutoStop::Used));
+        assert_eq!(count(20), (20, AutoStop::Used));
     }
 
     #[test]
