@@ -131,18 +131,12 @@ pub fn note(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::design::tests::{block, scene};
+    use crate::design::tests::{block, body_on_legs};
 
     #[test]
     fn thin_parts_are_those_narrower_than_the_narrowest_shadow_and_a_wider_picture_widens_them() {
-        // The body and legs 6 px wide of the test above, a fifth of the target.
-        let leg = |x: f64, y: f64| {
-            (140.0..230.0).contains(&y)
-                && [60.0, 100.0, 140.0, 180.0]
-                    .iter()
-                    .any(|&l| (l..l + 6.0).contains(&x))
-        };
-        let (pic, frame) = scene(|x, y| (x - 124.0).hypot(y - 90.0) <= 50.0 || leg(x, y));
+        // A body on legs 6 px wide, a fifth of the target.
+        let (pic, frame) = body_on_legs();
         let blocks = |least: f64| Request {
             fixed: vec![block(0.14, 0.07, least)],
             auto: vec![(AutoObject::Given(block(0.07, 0.07, 0.07)), 3)],

@@ -579,18 +579,23 @@ mod tests {
         assert!((cover.open() as f64) < 0.05 * pic.count() as f64);
     }
 
-    #[test]
-    fn an_automatic_count_goes_on_while_much_of_the_target_is_bare() {
-        // A body (a disc of radius 50 px) on four legs 6 px wide and 90 long, a fifth
-        // of the target: a ball on a leg adds under AUTO_MIN_RISE, so the rise alone
-        // stops at the body and leaves the legs bare.
+    /// A body (a disc of radius 50 px) on four legs 6 px wide and 90 long, a fifth of
+    /// the target.
+    pub(super) fn body_on_legs() -> (Picture, cover::Frame) {
         let leg = |x: f64, y: f64| {
             (140.0..230.0).contains(&y)
                 && [60.0, 100.0, 140.0, 180.0]
                     .iter()
                     .any(|&l| (l..l + 6.0).contains(&x))
         };
-        let (pic, frame) = scene(|x, y| (x - 124.0).hypot(y - 90.0) <= 50.0 || leg(x, y));
+        scene(|x, y| (x - 124.0).hypot(y - 90.0) <= 50.0 || leg(x, y))
+    }
+
+    #[test]
+    fn an_automatic_count_goes_on_while_much_of_the_target_is_bare() {
+        // A ball on a leg of the body on legs adds under AUTO_MIN_RISE, so the rise
+        // alone stops at the body and leaves the legs bare.
+        let (pic, frame) = body_on_legs();
         let mut cover = Cover::new(&pic, frame);
         let mut objects = Vec::new();
         let auto = [(AutoObject::Sphere { density: 705.0 }, usize::MAX)];
