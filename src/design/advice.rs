@@ -26,23 +26,18 @@ pub struct ThinParts {
 /// objects.
 pub fn thin_parts(picture: &Picture, frame: &Frame, request: &Request) -> Option<ThinParts> {
     let px = frame.metres_per_px;
-    let widths = request
+    // The narrowest object's least side, a ball of `auto:sphere` as small as it comes.
+    let widths = request.auto.iter().map(|(kind, _)| match kind {
+        AutoObject::Given(o) => o.shape.least_width(),
+        AutoObject::Sphere { .. } => 2.0 * LEAST_BALL_M,
+    });
+    let least = request
         .fixed
         .iter()
-        .chain(request.auto.iter().filter_map(|a| match &a.0 {
-            AutoObject::Given(o) => Some(o),
-            AutoObject::Sphere { .. } => None,
-        }));
-    let mut least = widths.fold(f64::INFINITY, |w, o| {
-        w.min(o.shape.least_width() * frame.m_lo)
-    });
-    if request
-        .auto
-        .iter()
-        .any(|a| matches!(a.0, AutoObject::Sphere { .. }))
-    {
-        least = least.min(2.0 * LEAST_BALL_M * frame.m_lo);
-    }
+        .map(|o| o.shape.least_width())
+        .chain(widths)
+        .fold(f64::INFINITY, f64::min)
+        * frame.m_lo;
     if !least.is_finite() {
         return None;
     }

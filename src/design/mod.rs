@@ -327,9 +327,13 @@ fn add_auto(
     // the time of the solve of that many.
     let stated = left.iter().filter(|&&n| n != usize::MAX).sum::<usize>();
     let cap = AUTO_CAP.max(stated);
-    for _ in 0..cap {
+    let before = objects.len();
+    loop {
         if left.iter().all(|&n| n == 0) {
             return AutoStop::Used;
+        }
+        if objects.len() - before == cap {
+            return AutoStop::Cap(cap);
         }
         let union = cover.union() as f64;
         // No placement gains more than the target left open.
@@ -371,10 +375,6 @@ fn add_auto(
         objects.push(o);
         cover.commit(p, family);
     }
-    if left.iter().all(|&n| n == 0) {
-        return AutoStop::Used;
-    }
-    AutoStop::Cap(cap)
 }
 
 /// Why object `k` has no place.

@@ -7,7 +7,8 @@ use std::path::Path;
 use std::process::Command;
 
 use crate::util::{
-    bsa, quick_solve, read_json, root, shared_quick_solve, solve, tmpdir, variant, zero_tolerances,
+    bsa, quick_solve, read_json, root, shared_quick_solve, solve, tmpdir, value_after, variant,
+    zero_tolerances,
 };
 
 #[test]
@@ -507,12 +508,8 @@ fn new_says_at_what_width_its_objects_can_draw_the_thin_parts() {
     assert!(ok, "{err}");
     let thin = "narrower than the narrowest shadow the objects cast (3.9 cm)";
     assert!(err.contains(thin), "{err}");
-    let width: f64 = err
-        .split("at --width ")
-        .nth(1)
-        .and_then(|s| s.split(' ').next())
-        .and_then(|w| w.parse().ok())
-        .unwrap_or_else(|| panic!("no width in: {err}"));
+    let width: f64 =
+        value_after(&err, "at --width ").unwrap_or_else(|| panic!("no width in: {err}"));
     assert!(width > 1.6, "{err}");
     // At that width the legs are as wide as the blocks' shadows.
     let w = width.to_string();

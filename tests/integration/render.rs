@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::util::{bsa, quick_solve, read_json, root, solve, tmpdir};
+use crate::util::{bsa, quick_solve, read_json, root, solve, tmpdir, value_after};
 
 fn render(scene: &Path, launch: &Path, out: &Path) -> (bool, String, String) {
     bsa(&[
@@ -390,12 +390,7 @@ fn new_reads_a_json_list_chess_pieces_and_chooses_a_count() {
     let (ok, out, err) = run(args(list.to_str().unwrap()));
     assert!(ok, "{err}");
     assert!(dir.join("pieces/pawn.obj").is_file());
-    let chosen: usize = out
-        .split(" objects (")
-        .nth(1)
-        .and_then(|s| s.split(' ').next())
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| panic!("{out}"));
+    let chosen: usize = value_after(&out, " objects (").unwrap_or_else(|| panic!("{out}"));
     assert!(
         chosen >= 1 && out.contains("chosen by auto:, which stopped as"),
         "{out}"

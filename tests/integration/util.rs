@@ -43,6 +43,11 @@ pub fn solve(scene: &Path, out: &Path, extra: &[&str]) -> String {
     stdout
 }
 
+/// The number (or other value) that follows `marker` in `text`, up to the next space.
+pub fn value_after<T: std::str::FromStr>(text: &str, marker: &str) -> Option<T> {
+    text.split(marker).nth(1)?.split(' ').next()?.parse().ok()
+}
+
 /// The JSON file at `path`, which must exist and parse.
 pub fn read_json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
