@@ -514,8 +514,11 @@ impl<'a> Budget<'a> {
         threshold: f64,
         pool: &rayon::ThreadPool,
     ) -> bool {
-        /// Samples taken between two looks at the count.
-        const CHUNK: usize = 128;
+        /// Samples taken between two looks at the count: few, so that a launcher that
+        /// fails stops soon after its `n - needed + 1`-th miss (13 of 128). Each draw
+        /// comes from its own index, so the answer is the same for any chunk; 16 against
+        /// 128 took THE THINKER's launcher needs from 1.12 to 0.87 s.
+        const CHUNK: usize = 16;
         // The least number of successes whose fraction reaches the target, as IouStats
         // computes the fraction.
         let Some(needed) = (0..=n).find(|&c| c as f64 / n.max(1) as f64 >= PROBABILITY_TARGET)

@@ -48,13 +48,16 @@ pub(super) struct Design {
     pub(super) inventory: Inventory,
     pub(super) seed: u64,
     pub(super) stage: Stage,
+    /// Whether `--width` was given (else the stage has the default width).
+    pub(super) width_given: bool,
 }
 
 impl Design {
     pub(super) fn new(args: DesignArgs) -> Result<Design> {
         let inventory = read_inventory(&args.objects)?;
+        let width = args.width.unwrap_or(Stage::default().picture_width);
         for (name, value, lo, hi) in [
-            ("--width", args.width, 0.01, 1000.0),
+            ("--width", width, 0.01, 1000.0),
             ("--light-height", args.light_height, 0.1, 1000.0),
             ("--t", args.t, 0.05, 60.0),
         ] {
@@ -66,11 +69,12 @@ impl Design {
             inventory,
             seed: args.seed,
             stage: Stage {
-                picture_width: args.width,
+                picture_width: width,
                 light_height: args.light_height,
                 t: args.t,
                 ..Stage::default()
             },
+            width_given: args.width.is_some(),
         })
     }
 }

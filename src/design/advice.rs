@@ -1,6 +1,7 @@
 //! What `bsa new` tells the user when the box of objects cannot draw the picture, which
 //! no solve mends ([`note`]): parts of the picture narrower than any of the objects'
-//! shadows ([`thin_parts`], [`ThinParts`]) and a target the objects leave bare.
+//! shadows ([`thin_parts`], [`ThinParts`]) and a target the objects leave bare; and the
+//! wider picture it takes itself for an automatic inventory ([`auto_width`]).
 
 use super::cover::{Frame, LEAST_BALL_M};
 use super::picture::Picture;
@@ -71,6 +72,38 @@ pub fn thin_parts(picture: &Picture, frame: &Frame, request: &Request) -> Option
     })
 }
 
+/// The most an automatic inventory widens the picture ([`auto_width`]): twice the
+/// width is four times the area, and the count grows with the area up to the cap of
+/// [`super::AUTO_CAP`] objects; beyond, the note tells the width and leaves it to the user.
+const MOST_WIDENING: f64 = 2.0;
+
+/// A width (m) up to the centimetre above, so that the width said is enough.
+fn up_to_cm(width: f64) -> f64 {
+    (100.0 * width).ceil() / 100.0
+}
+
+/// The picture width (m) that `bsa new` takes for a `request` with `auto:` items when
+/// the user sets none, the picture now `width` wide (`frame` its design frame): where more
+/// than [`BARE_SHARE`] of `picture` is narrower than the narrowest shadow the objects
+/// cast, the width at which all but that share is as wide (up to the centimetre, at most
+/// [`MOST_WIDENING`] times `width`), with the thin parts found at `width`. `None` where
+/// the picture is wide enough, the request has no `auto:` item (its count is the user's)
+/// or no width within reach helps.
+pub fn auto_width(
+    picture: &Picture,
+    frame: &Frame,
+    request: &Request,
+    width: f64,
+) -> Option<(f64, ThinParts)> {
+    if request.auto.is_empty() {
+        return None;
+    }
+    let thin = thin_parts(picture, frame, request)?;
+    let wider = up_to_cm(thin.width_needed);
+    (thin.share > BARE_SHARE && wider > width && wider <= MOST_WIDENING * width)
+        .then_some((wider, thin))
+}
+
 /// With more than [`BARE_SHARE`] of the target bare at the start, a final (or
 /// start) IoU below this says the objects are too few or of the wrong proportions for
 /// the picture.
@@ -96,8 +129,7 @@ pub fn note(
         let wider = if t.width_needed.is_finite() {
             format!(
                 "at --width {:.2} or more, all but {:.0} % of it is as wide; or give narrower objects",
-                // Up, so that the width said is enough.
-                (100.0 * t.width_needed).ceil() / 100.0,
+                up_to_cm(t.width_needed),
                 100.0 * BARE_SHARE
             )
         } else {
@@ -165,5 +197,36 @@ mod tests {
             auto: Vec::new(),
         };
         assert_eq!(thin_parts(&pic, &frame, &none), None);
+    }
+
+    #[test]
+    fn an_automatic_inventory_widens_the_picture_for_its_thin_parts_up_to_twice() {
+        let (pic, frame) = body_on_legs();
+        let width = frame.metres_per_px * pic.width as f64;
+        let px = |n: f64| n * frame.metres_per_px / frame.m_lo;
+        let auto = |least: f64| Request {
+            fixed: Vec::new(),
+            auto: vec![(AutoObject::Given(block(0.14, 0.07, least)), usize::MAX)],
+        };
+        // Legs 6 px wide against a shadow 10 px across: the width the note gives, to the
+        // centimetre above.
+        let (taken, thin) = auto_width(&pic, &frame, &auto(px(10.0)), width).unwrap();
+        assert_eq!(thin, thin_parts(&pic, &frame, &auto(px(10.0))).unwrap());
+        assert_eq!(taken, up_to_cm(thin.width_needed));
+        assert!(
+            taken > width && taken <= MOST_WIDENING * width,
+            "{taken} of {width}"
+        );
+        // The user's own count keeps the user's picture; so does a shadow as narrow as
+        // the legs, and one so wide that no picture within twice the width helps.
+        let stated = Request {
+            fixed: vec![block(0.14, 0.07, px(10.0))],
+            auto: Vec::new(),
+        };
+        assert_eq!(auto_width(&pic, &frame, &stated, width), None);
+        assert_eq!(auto_width(&pic, &frame, &auto(px(4.0)), width), None);
+        let far = thin_parts(&pic, &frame, &auto(px(30.0))).unwrap();
+        assert!(far.width_needed > MOST_WIDENING * width, "{far:?}");
+        assert_eq!(auto_width(&pic, &frame, &auto(px(30.0)), width), None);
     }
 }

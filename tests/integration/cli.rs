@@ -521,6 +521,21 @@ fn new_says_at_what_width_its_objects_can_draw_the_thin_parts() {
         &["--choose-by", "start", "--width", &w],
     );
     assert!(ok && !err.contains("narrower than"), "{err}");
+    // The same block as an automatic item, and no --width: bsa new takes that width
+    // itself, says so and writes it, and so leaves no thin parts to tell of.
+    let auto = tmpdir("new-thin-auto");
+    let (ok, out, err) = new_in(
+        &auto,
+        &target,
+        "auto:box:0.14x0.07x0.035",
+        &["--choose-by", "start"],
+    );
+    assert!(ok && !err.contains("narrower than"), "{err}");
+    let taken: f64 =
+        value_after(&out, "a picture ").unwrap_or_else(|| panic!("no width taken: {out}"));
+    assert_eq!(taken, width, "{out}");
+    let scene = read_json(&auto.join("out/scene.json"));
+    assert_eq!(scene["receiver"]["width"].as_f64(), Some(width));
 }
 
 #[test]
