@@ -51,6 +51,29 @@ impl Stage {
     pub fn picture_height(&self) -> f64 {
         self.picture_width * self.pixels.1 as f64 / self.pixels.0 as f64
     }
+
+    /// A scene file of this stage: the picture on the floor under the light, the table,
+    /// `occluders` (scene-file JSON) and the target file `target`, with the default
+    /// strategy for `objects` objects.
+    pub fn scene_json(
+        &self,
+        name: &str,
+        target: &str,
+        occluders: Vec<Value>,
+        objects: usize,
+    ) -> Value {
+        json!({
+            "name": name,
+            "target": target,
+            "t": self.t,
+            "light": [0.0, 0.0, self.light_height],
+            "receiver": {"center": [0.0, 0.0, 0.0], "u": [1.0, 0.0, 0.0], "v": [0.0, 1.0, 0.0],
+                         "width": self.picture_width, "height": self.picture_height()},
+            "table": {"center": [0.0, 0.0, -0.5], "size": [40.0, 40.0, 1.0]},
+            "occluders": occluders,
+            "strategy": default_strategy(objects),
+        })
+    }
 }
 
 /// Why a problem cannot be planted.
@@ -222,21 +245,11 @@ impl Layout {
                 json!({"occluder": self.objects[*i].0, "point": [p.x, p.y, p.z], "pixel": [px.x, px.y]})
             })
             .collect();
-        let mut scene = json!({
-            "name": name,
-            "target": target,
-            "t": s.t,
-            "light": [0.0, 0.0, s.light_height],
-            "receiver": {"center": [0.0, 0.0, 0.0], "u": [1.0, 0.0, 0.0], "v": [0.0, 1.0, 0.0],
-                         "width": s.picture_width, "height": s.picture_height()},
-            "table": {"center": [0.0, 0.0, -0.5], "size": [40.0, 40.0, 1.0]},
-            "occluders": occluders,
-            "seed": seed,
-        });
+        let mut scene = s.scene_json(name, target, occluders, self.objects.len());
+        scene["seed"] = seed.into();
         if !hints.is_empty() {
             scene["hints"] = Value::from(hints);
         }
-        scene["strategy"] = default_strategy(self.objects.len());
         scene
     }
 }

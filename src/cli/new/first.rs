@@ -272,15 +272,5 @@ fn probe_json(protos: &[Prototype], stage: &Stage, name: &str) -> Value {
                        "position": [0.0, -30.0, 100.0 + 10.0 * k as f64], "density": p.density})
         })
         .collect();
-    json!({
-        "name": name,
-        "target": SCRATCH_TARGET,
-        "t": stage.t,
-        "light": [0.0, 0.0, stage.light_height],
-        "receiver": {"center": [0.0, 0.0, 0.0], "u": [1.0, 0.0, 0.0], "v": [0.0, 1.0, 0.0],
-                     "width": stage.picture_width, "height": stage.picture_height()},
-        "table": {"center": [0.0, 0.0, -0.5], "size": [40.0, 40.0, 1.0]},
-        "occluders": occluders,
-        "strategy": default_strategy(protos.len().max(1)),
-    })
+    stage.scene_json(name, SCRATCH_TARGET, occluders, protos.len().max(1))
 }
