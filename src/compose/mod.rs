@@ -3,8 +3,9 @@
 //! [`Setting`] (each of [`crate::design::CEILINGS`] in each of [`ORDERS`]), each design made
 //! contact-free ([`separate`]); the designs that differ from those before them then
 //! race ([`race`]) and the best ([`Variant::better_than`]) is kept ([`Found`]). When no
-//! design's solve reaches [`REPLACE_BELOW`], a second round designs every setting again
-//! with its objects placed anew ([`crate::design::cover::Cover::replace`]) and races those.
+//! design's solve reaches [`REPLACE_BELOW`], a second round designs again under the
+//! ceilings of the best designs ([`crate::design::ANEW_CEILINGS`]) with the objects
+//! placed anew ([`crate::design::cover::Cover::replace`]) and races those.
 //!
 //! A start guess's IoU says little of where its solve ends: on 27 held-out pictures the
 //! design with the best start was the best solved one for 12. So the designs are
@@ -24,7 +25,9 @@ use serde_json::Value;
 
 use crate::design::launch::{Geometry, Plan};
 use crate::design::picture::Picture;
-use crate::design::{self, separate, DesignError, Order, Request, ORDERS, REPLACE_BELOW};
+use crate::design::{
+    self, separate, DesignError, Order, Request, ANEW_CEILINGS, ORDERS, REPLACE_BELOW,
+};
 use crate::energy::Weights;
 use crate::evaluate::Problem;
 use crate::optimize::solver::{self, Schedule, Silent, SolveOptions};
@@ -58,22 +61,35 @@ pub struct Setting {
     pub replace: bool,
 }
 
-/// Every setting of a search under `ceilings`, orders outermost: first as greedy,
-/// exchanged and polished; then, in the second round, with every object placed anew
-/// too.
+/// The first round's settings under `ceilings`, orders outermost.
 pub fn settings(ceilings: &[f64]) -> Vec<Setting> {
-    [false, true]
-        .into_iter()
-        .flat_map(|replace| {
-            ORDERS.iter().flat_map(move |&order| {
-                ceilings.iter().map(move |&ceiling| Setting {
-                    order,
-                    ceiling,
-                    replace,
-                })
+    ORDERS
+        .iter()
+        .flat_map(|&order| {
+            ceilings.iter().map(move |&ceiling| Setting {
+                order,
+                ceiling,
+                replace: false,
             })
         })
         .collect()
+}
+
+/// The second round's settings: every order under each of `ceilings` (the first
+/// round's best, [`ANEW_CEILINGS`]), orders outermost, with every object placed anew.
+fn placed_anew(ceilings: &[f64]) -> impl Iterator<Item = Setting> + '_ {
+    ORDERS.iter().flat_map(move |&order| {
+        ceilings.iter().map(move |&ceiling| Setting {
+            order,
+            ceiling,
+            replace: true,
+        })
+    })
+}
+
+/// The most designs a search under `ceilings` makes (one scene file each).
+pub fn most_designs(ceilings: &[f64]) -> usize {
+    settings(ceilings).len() + ORDERS.len() * ANEW_CEILINGS.min(ceilings.len())
 }
 
 /// Where a design's trial solve ended.
@@ -192,30 +208,62 @@ pub struct Found {
     pub trials: Vec<Trial>,
     /// The ceilings searched.
     pub ceilings: Vec<f64>,
+    /// The ceilings of the second round (none when it did not run).
+    pub anew_under: Vec<f64>,
 }
 
 impl Search<'_> {
     /// Design under every setting of the first round and race the designs; when no
-    /// trial reaches [`REPLACE_BELOW`], the second round too; keep the best of all.
-    /// After an interrupt the designs not begun fail with [`SearchError::Interrupted`].
+    /// trial reaches [`REPLACE_BELOW`], a second round under the best design's ceiling
+    /// ([`placed_anew`]); keep the best of all. After an interrupt the designs not
+    /// begun fail with [`SearchError::Interrupted`].
     pub fn run(&self, watch: &dyn Watch, interrupts: &AtomicUsize) -> Found {
-        let settings = settings(self.ceilings);
-        let first_round = ORDERS.len() * self.ceilings.len();
+        let mut settings = settings(self.ceilings);
+        let first_round = settings.len();
         let mut designed = Vec::new();
         let mut same_as = Vec::new();
-        let round = |ks, designed: &mut _, same_as: &mut _| {
-            self.round(&settings, ks, designed, same_as, watch, interrupts)
-        };
-        round(0..first_round, &mut designed, &mut same_as);
+        self.round(
+            &settings,
+            0..first_round,
+            &mut designed,
+            &mut same_as,
+            watch,
+            interrupts,
+        );
         let best_trial = designed
             .iter()
             .filter_map(|v| v.as_ref().ok()?.solved)
             .filter(|s| s.clear && s.finished())
             .map(|s| s.iou)
             .fold(f64::NEG_INFINITY, f64::max);
+        // The ceilings of the best designs, best first.
+        let mut ranked: Vec<&Variant> = designed.iter().flatten().collect();
+        ranked.sort_by(|a, b| match (a.better_than(b), b.better_than(a)) {
+            (true, _) => std::cmp::Ordering::Less,
+            (_, true) => std::cmp::Ordering::Greater,
+            _ => std::cmp::Ordering::Equal,
+        });
+        let mut anew_under: Vec<f64> = Vec::new();
+        for v in ranked {
+            if anew_under.len() < ANEW_CEILINGS && !anew_under.contains(&v.setting.ceiling) {
+                anew_under.push(v.setting.ceiling);
+            }
+        }
         let second = self.rounds >= 2 && self.trial && best_trial < REPLACE_BELOW;
-        if second && interrupts.load(Ordering::SeqCst) == 0 {
-            round(first_round..settings.len(), &mut designed, &mut same_as);
+        if !second || interrupts.load(Ordering::SeqCst) > 0 {
+            anew_under.clear();
+        }
+        if !anew_under.is_empty() {
+            settings.extend(placed_anew(&anew_under));
+            let ks = first_round..settings.len();
+            self.round(
+                &settings,
+                ks,
+                &mut designed,
+                &mut same_as,
+                watch,
+                interrupts,
+            );
         }
         let mut found = Found {
             best: None,
@@ -223,6 +271,7 @@ impl Search<'_> {
             first_error: None,
             trials: Vec::new(),
             ceilings: self.ceilings.to_vec(),
+            anew_under,
         };
         for (v, same) in designed.into_iter().zip(same_as) {
             match v {
@@ -474,32 +523,38 @@ pub fn race(
 }
 
 impl Found {
-    /// "trial solves under ceilings 0.8 / 0.7 / ... of the light's height: IoU a / b /
-    /// ... (largest object first), e / same / ... (best fit first)[; placed anew:
-    /// ...]; kept the design under c, best fit first[, placed anew]": what the choice
-    /// was made on (a trial that ended with a contact says so; "same" is a design that
-    /// an earlier one made too). The second round only when it ran.
+    /// "trial solves under ceilings 0.8 / 0.7 / 0.6 / 0.5 of the light's height: IoU a
+    /// / b / c / d (largest object first), e / same / f / g (best fit first)[; placed
+    /// anew under 0.6 / 0.8: h / i (largest object first), same / j (best fit
+    /// first)]; kept the design under c, best fit first[, placed anew]": what the choice was made on (a trial that ended
+    /// with a contact says so; "same" is a design that an earlier one made too). The
+    /// second round only when it ran.
     pub fn trials_line(&self, kept: Setting) -> String {
         let ceilings: Vec<String> = self.ceilings.iter().map(|c| format!("{c}")).collect();
-        let per_round: Vec<String> = self
-            .trials
-            .chunks(ORDERS.len() * self.ceilings.len())
-            .map(|round| {
-                let per_order: Vec<String> = ORDERS
-                    .iter()
-                    .zip(round.chunks(self.ceilings.len()))
-                    .map(|(order, trials)| {
-                        let ious: Vec<String> = trials.iter().map(trial_text).collect();
-                        format!("{} ({})", ious.join(" / "), order.label())
-                    })
-                    .collect();
-                per_order.join(", ")
-            })
-            .collect();
+        let (first, second) = self.trials.split_at(ORDERS.len() * self.ceilings.len());
+        let per_order = |trials: &[Trial], per: usize| -> String {
+            let texts: Vec<String> = ORDERS
+                .iter()
+                .zip(trials.chunks(per))
+                .map(|(order, trials)| {
+                    let ious: Vec<String> = trials.iter().map(trial_text).collect();
+                    format!("{} ({})", ious.join(" / "), order.label())
+                })
+                .collect();
+            texts.join(", ")
+        };
+        let anew = match self.anew_under.as_slice() {
+            [] => String::new(),
+            under => {
+                let under: Vec<String> = under.iter().map(|c| format!("{c}")).collect();
+                let ious = per_order(second, under.len());
+                format!("; placed anew under {}: {ious}", under.join(" / "))
+            }
+        };
         format!(
-            "trial solves under ceilings {} of the light's height: IoU {}; kept the design under {}, {}{}",
+            "trial solves under ceilings {} of the light's height: IoU {}{anew}; kept the design under {}, {}{}",
             ceilings.join(" / "),
-            per_round.join("; placed anew: "),
+            per_order(first, self.ceilings.len()),
             kept.ceiling,
             kept.order.label(),
             if kept.replace { ", placed anew" } else { "" }

@@ -215,8 +215,9 @@ fn new_designs_a_scene_that_solve_takes_as_it_is() {
     assert!(!err.contains("note:"), "{err}");
     // A trial reaches 0.985 (`design::REPLACE_BELOW`), so the designs are not made
     // again with their objects placed anew.
-    let (_, orders, (_, kept)) = trials(&out);
-    let best = finished(&orders).fold(0.0, f64::max);
+    let trials = trials(&out);
+    let (orders, kept) = (&trials.orders, &trials.kept.1);
+    let best = finished(orders).fold(0.0, f64::max);
     assert!(best >= 0.985, "{out}");
     assert_eq!(orders.len(), 2, "{out}");
     assert!(!kept.contains("placed anew"), "{out}");
@@ -444,13 +445,28 @@ fn new_fly(dir: &Path, extra: &[&str]) -> String {
 
 /// What `bsa new` printed of its trial solves: the ceilings, each order's trial IoUs
 /// (`None` for a design that an earlier one made too, "same"; `Some(None)` for one the
-/// race of the designs left behind before its last stage; the second round's orders,
-/// when it ran, labelled "..., placed anew") and the ceiling and order it kept.
-type Trials = (
-    Vec<f64>,
-    Vec<(String, Vec<Option<Option<f64>>>)>,
-    (f64, String),
-);
+/// race of the designs left behind before its last stage), the second round's ceilings
+/// and orders when it ran (labelled "..., placed anew"), and the ceiling and order it
+/// kept.
+struct Trials {
+    ceilings: Vec<f64>,
+    anew_under: Vec<f64>,
+    orders: Vec<(String, Vec<Option<Option<f64>>>)>,
+    kept: (f64, String),
+}
+
+impl Trials {
+    /// The kept design's trial: `Some(None)` if the race left it behind.
+    fn kept_trial(&self) -> Option<Option<f64>> {
+        let (ceiling, order) = &self.kept;
+        let under = match order.ends_with("placed anew") {
+            true => &self.anew_under,
+            false => &self.ceilings,
+        };
+        let at = under.iter().position(|c| c == ceiling).unwrap();
+        self.orders.iter().find(|o| &o.0 == order).unwrap().1[at]
+    }
+}
 
 /// The IoUs of the designs that ran every stage of their trial.
 fn finished(orders: &[(String, Vec<Option<Option<f64>>>)]) -> impl Iterator<Item = f64> + '_ {
@@ -481,15 +497,23 @@ fn trials(out: &str) -> Trials {
         let s = line.split(after).nth(1).unwrap_or_else(|| panic!("{line}"));
         s.split(before).next().unwrap().to_string()
     };
-    let ceilings = between("ceilings ", " of the")
-        .split(" / ")
-        .map(|v| v.parse().unwrap())
-        .collect();
+    let numbers =
+        |list: &str| -> Vec<f64> { list.split(" / ").map(|v| v.parse().unwrap()).collect() };
+    let ceilings = numbers(&between("ceilings ", " of the"));
+    let mut anew_under = Vec::new();
     let mut orders = Vec::new();
     for (round, part) in between("IoU ", "; kept")
-        .split("; placed anew: ")
+        .split("; placed anew under ")
         .enumerate()
     {
+        let part = match round {
+            0 => part,
+            _ => {
+                let (under, part) = part.split_once(": ").unwrap_or_else(|| panic!("{line}"));
+                anew_under = numbers(under);
+                part
+            }
+        };
         for order in part.split("), ") {
             let (ious, label) = order.split_once(" (").unwrap_or_else(|| panic!("{line}"));
             let ious = ious
@@ -504,11 +528,16 @@ fn trials(out: &str) -> Trials {
             orders.push((label, ious));
         }
     }
-    let (ceiling, order) = between("kept the design under ", "\n")
+    let kept = between("kept the design under ", "\n")
         .split_once(", ")
         .map(|(c, o)| (c.parse().unwrap(), o.to_string()))
         .unwrap_or_else(|| panic!("{line}"));
-    (ceilings, orders, (ceiling, order))
+    Trials {
+        ceilings,
+        anew_under,
+        orders,
+        kept,
+    }
 }
 
 #[test]
@@ -518,11 +547,11 @@ fn new_keeps_the_design_that_solves_best_and_solve_ends_where_its_trial_did() {
     let d = tmpdir("new-trials");
     let dir = d.join("fly");
     let out = new_fly(&dir, &[]);
-    let (ceilings, orders, (ceiling, order)) = trials(&out);
-    assert_eq!(ceilings.len(), 4, "{out}");
+    let t = trials(&out);
+    assert_eq!(t.ceilings.len(), 4, "{out}");
     // Fly's trials end under 0.985 (`design::REPLACE_BELOW`), so its designs are made
     // again with the objects placed anew, and the best of both rounds is kept.
-    let labels: Vec<&str> = orders.iter().map(|o| o.0.as_str()).collect();
+    let labels: Vec<&str> = t.orders.iter().map(|o| o.0.as_str()).collect();
     assert_eq!(
         labels,
         [
@@ -533,15 +562,29 @@ fn new_keeps_the_design_that_solves_best_and_solve_ends_where_its_trial_did() {
         ],
         "{out}"
     );
+    // The second round is made under the ceilings of the first round's two best trials
+    // (`design::ANEW_CEILINGS`), best first.
+    let mut first: Vec<(f64, f64)> = t.orders[..2]
+        .iter()
+        .flat_map(|o| t.ceilings.iter().zip(&o.1))
+        .filter_map(|(&c, iou)| Some(((*iou)??, c)))
+        .collect();
+    first.sort_by(|a, b| b.partial_cmp(a).unwrap());
+    let mut best_ceilings: Vec<f64> = Vec::new();
+    for (_, c) in first {
+        if !best_ceilings.contains(&c) {
+            best_ceilings.push(c);
+        }
+    }
+    assert_eq!(t.anew_under, best_ceilings[..2], "{out}");
     // Every design is solved once: the first order's all, the second's where it
     // differs; the race (one rung, `compose::RUNGS`) runs each to its end.
-    assert!(orders[0].1.iter().all(Option::is_some), "{out}");
-    assert!(orders.iter().all(|o| o.1.len() == 4), "{out}");
-    assert!(!orders.iter().any(|o| o.1.contains(&Some(None))), "{out}");
-    let best = finished(&orders).fold(0.0, f64::max);
-    let at = ceilings.iter().position(|&c| c == ceiling).unwrap();
-    let kept = orders.iter().find(|o| o.0 == order).unwrap().1[at];
-    assert_eq!(kept, Some(Some(best)), "{out}");
+    assert!(t.orders[0].1.iter().all(Option::is_some), "{out}");
+    assert!(t.orders[..2].iter().all(|o| o.1.len() == 4), "{out}");
+    assert!(t.orders[2..].iter().all(|o| o.1.len() == 2), "{out}");
+    assert!(!t.orders.iter().any(|o| o.1.contains(&Some(None))), "{out}");
+    let best = finished(&t.orders).fold(0.0, f64::max);
+    assert_eq!(t.kept_trial(), Some(Some(best)), "{out}");
     // The written scene is the design that was tried: its solve's last stage ends where
     // the trial did, and its polish (which the trials leave out, with the trades; fly's
     // solve takes none) goes on from there to a picture no worse. One attempt: a second

@@ -274,9 +274,8 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     let created = !dir.exists();
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let probe_file = dir.join(SCRATCH_PROBE);
-    let most_settings = compose::settings(&design::CEILINGS)
-        .len()
-        .max(compose::settings(&tolerant::LAUNCHER_CEILINGS).len());
+    let most_settings = compose::most_designs(&design::CEILINGS)
+        .max(compose::most_designs(&tolerant::LAUNCHER_CEILINGS));
     let design_files: Vec<PathBuf> = (0..most_settings)
         .map(|k| dir.join(format!(".bsa-new-design-{k}.json")))
         .collect();
