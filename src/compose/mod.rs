@@ -61,35 +61,22 @@ pub struct Setting {
     pub replace: bool,
 }
 
-/// The first round's settings under `ceilings`, orders outermost.
-pub fn settings(ceilings: &[f64]) -> Vec<Setting> {
-    ORDERS
-        .iter()
-        .flat_map(|&order| {
-            ceilings.iter().map(move |&ceiling| Setting {
-                order,
-                ceiling,
-                replace: false,
-            })
-        })
-        .collect()
-}
-
-/// The second round's settings: every order under each of `ceilings` (the first
-/// round's best, [`ANEW_CEILINGS`]), orders outermost, with every object placed anew.
-fn placed_anew(ceilings: &[f64]) -> impl Iterator<Item = Setting> + '_ {
+/// The settings of a round under `ceilings`, orders outermost: the first round's
+/// (greedy, exchanged and polished) or, with `replace`, the second's, with every object
+/// placed anew too.
+fn round_settings(ceilings: &[f64], replace: bool) -> impl Iterator<Item = Setting> + '_ {
     ORDERS.iter().flat_map(move |&order| {
         ceilings.iter().map(move |&ceiling| Setting {
             order,
             ceiling,
-            replace: true,
+            replace,
         })
     })
 }
 
 /// The most designs a search under `ceilings` makes (one scene file each).
 pub fn most_designs(ceilings: &[f64]) -> usize {
-    settings(ceilings).len() + ORDERS.len() * ANEW_CEILINGS.min(ceilings.len())
+    ORDERS.len() * (ceilings.len() + ANEW_CEILINGS.min(ceilings.len()))
 }
 
 /// Where a design's trial solve ended.
@@ -132,7 +119,11 @@ impl Variant {
     /// The solved picture first (contact-free first, then the higher IoU), then the
     /// start guess's (the same order).
     pub fn better_than(&self, other: &Variant) -> bool {
-        rank(self.solved, self.clear, self.iou) > rank(other.solved, other.clear, other.iou)
+        self.rank() > other.rank()
+    }
+
+    fn rank(&self) -> (bool, bool, f64, bool, f64) {
+        rank(self.solved, self.clear, self.iou)
     }
 }
 
@@ -169,7 +160,7 @@ pub trait Watch: Sync {
 }
 
 /// Where the designs' scenes are written and loaded from: one scene file per setting
-/// of [`settings`], in the scene's folder (its mesh paths are relative to it).
+/// of [`round_settings`], in the scene's folder (its mesh paths are relative to it).
 pub trait Scenes: Sync {
     /// Write the scene file `json` of setting `k` and load it back.
     fn load(&self, k: usize, json: &Value) -> Result<Scene, SearchError>;
@@ -199,10 +190,10 @@ pub struct Search<'a> {
 }
 
 /// What the search found: the best design, the others, the first error (when no design
-/// was made) and every setting's trial, in the order of [`settings`].
+/// was made) and every setting's trial, in the order of [`round_settings`].
 pub struct Found {
     pub best: Option<Variant>,
-    /// Every other design made, in the order of [`settings`] (repeats left out).
+    /// Every other design made, in the order of [`round_settings`] (repeats left out).
     pub others: Vec<Variant>,
     pub first_error: Option<SearchError>,
     pub trials: Vec<Trial>,
@@ -214,11 +205,11 @@ pub struct Found {
 
 impl Search<'_> {
     /// Design under every setting of the first round and race the designs; when no
-    /// trial reaches [`REPLACE_BELOW`], a second round under the best design's ceiling
-    /// ([`placed_anew`]); keep the best of all. After an interrupt the designs not
+    /// trial reaches [`REPLACE_BELOW`], a second round under the ceilings of the best
+    /// designs ([`ANEW_CEILINGS`]); keep the best of all. After an interrupt the designs not
     /// begun fail with [`SearchError::Interrupted`].
     pub fn run(&self, watch: &dyn Watch, interrupts: &AtomicUsize) -> Found {
-        let mut settings = settings(self.ceilings);
+        let mut settings: Vec<Setting> = round_settings(self.ceilings, false).collect();
         let first_round = settings.len();
         let mut designed = Vec::new();
         let mut same_as = Vec::new();
@@ -236,25 +227,18 @@ impl Search<'_> {
             .filter(|s| s.clear && s.finished())
             .map(|s| s.iou)
             .fold(f64::NEG_INFINITY, f64::max);
-        // The ceilings of the best designs, best first.
-        let mut ranked: Vec<&Variant> = designed.iter().flatten().collect();
-        ranked.sort_by(|a, b| match (a.better_than(b), b.better_than(a)) {
-            (true, _) => std::cmp::Ordering::Less,
-            (_, true) => std::cmp::Ordering::Greater,
-            _ => std::cmp::Ordering::Equal,
-        });
-        let mut anew_under: Vec<f64> = Vec::new();
-        for v in ranked {
-            if anew_under.len() < ANEW_CEILINGS && !anew_under.contains(&v.setting.ceiling) {
-                anew_under.push(v.setting.ceiling);
-            }
-        }
         let second = self.rounds >= 2 && self.trial && best_trial < REPLACE_BELOW;
-        if !second || interrupts.load(Ordering::SeqCst) > 0 {
-            anew_under.clear();
-        }
-        if !anew_under.is_empty() {
-            settings.extend(placed_anew(&anew_under));
+        let mut anew_under: Vec<f64> = Vec::new();
+        if second && interrupts.load(Ordering::SeqCst) == 0 {
+            // The ceilings of the best designs, best first.
+            let mut ranked: Vec<&Variant> = designed.iter().flatten().collect();
+            ranked.sort_by(|a, b| b.rank().partial_cmp(&a.rank()).expect("IoUs are numbers"));
+            for v in ranked {
+                if anew_under.len() < ANEW_CEILINGS && !anew_under.contains(&v.setting.ceiling) {
+                    anew_under.push(v.setting.ceiling);
+                }
+            }
+            settings.extend(round_settings(&anew_under, true));
             let ks = first_round..settings.len();
             self.round(
                 &settings,
@@ -526,9 +510,9 @@ impl Found {
     /// "trial solves under ceilings 0.8 / 0.7 / 0.6 / 0.5 of the light's height: IoU a
     /// / b / c / d (largest object first), e / same / f / g (best fit first)[; placed
     /// anew under 0.6 / 0.8: h / i (largest object first), same / j (best fit
-    /// first)]; kept the design under c, best fit first[, placed anew]": what the choice was made on (a trial that ended
-    /// with a contact says so; "same" is a design that an earlier one made too). The
-    /// second round only when it ran.
+    /// first)]; kept the design under c, best fit first[, placed anew]": what the
+    /// choice was made on (a trial that ended with a contact says so; "same" is a
+    /// design that an earlier one made too). The second round only when it ran.
     pub fn trials_line(&self, kept: Setting) -> String {
         let ceilings: Vec<String> = self.ceilings.iter().map(|c| format!("{c}")).collect();
         let (first, second) = self.trials.split_at(ORDERS.len() * self.ceilings.len());
