@@ -164,9 +164,9 @@ fn asymmetric_brick_conserves_l_and_energy_and_converges() {
     let times = grid(2.0, 101);
     let (dl, de) = conservation(&f, &mp, &times);
     assert!(dl < 1e-12, "L drift {dl}");
-    // Measured 1.1e-9 with the default 0.02 rad per step (error ~ angle^4).
-    assert!(de < 2e-9, "energy drift {de}");
-    // 10x finer steps: measured difference 7.1e-7 rad after 2 s; require 2e-6.
+    // Measured 4.6e-8 with the default 0.05 rad per step (error ~ angle^4).
+    assert!(de < 1e-7, "energy drift {de}");
+    // 10x finer steps: measured difference 2.9e-5 rad after 2 s; require 6e-5.
     let fine_cfg = FlightConfig {
         rk4_max_step: cfg.rk4_max_step / 10.0,
         rk4_max_angle: cfg.rk4_max_angle / 10.0,
@@ -178,11 +178,11 @@ fn asymmetric_brick_conserves_l_and_energy_and_converges() {
         .iter()
         .map(|&t| angle_between(f.orientation(t), fine.orientation(t)))
         .fold(0.0, f64::max);
-    assert!(err < 2e-6, "vs 10x finer: {err}");
+    assert!(err < 6e-5, "vs 10x finer: {err}");
     // Independent Euler-equation reference.
     let reference = reference_rotation(&mp, q0, w, 2.0, 200_000);
     let err = angle_between(f.orientation(2.0), reference);
-    assert!(err < 2e-6, "vs Euler reference: {err}");
+    assert!(err < 6e-5, "vs Euler reference: {err}");
     // The gyroscopic motion matters: constant-w rotation is far off.
     assert!(angle_between(DQuat::from_scaled_axis(w * 2.0) * q0, reference) > 0.1);
     // The speed bound holds and is tight (the exact polhode maximum): 2 s covers
@@ -213,7 +213,8 @@ fn intermediate_axis_flips_and_still_conserves() {
         .collect();
     assert!(body_wy.iter().any(|&y| y < -19.0), "the body never flipped");
     let (dl, de) = conservation(&f, &mp, &times);
-    assert!(dl < 1e-12 && de < 2e-9, "{dl} {de}");
+    // Measured energy drift 5.8e-8 at the default 0.05 rad per step.
+    assert!(dl < 1e-12 && de < 1.5e-7, "{dl} {de}");
 }
 
 #[test]
@@ -327,7 +328,8 @@ fn queries_beyond_t_max_extend_the_integration() {
     let (q, wq) = (short.orientation(-0.4), short.angular_velocity(-0.4));
     let back = spun(&mp, q, wq, 0.5, &cfg);
     let err = angle_between(back.orientation(0.4), DQuat::IDENTITY);
-    assert!(err < 1e-8, "{err}");
+    // Two RK4 integrations of 0.4 s, one backwards: measured 5.5e-8 rad apart.
+    assert!(err < 1.5e-7, "{err}");
     assert!(angle_between(q, DQuat::IDENTITY) > 0.5);
 }
 
