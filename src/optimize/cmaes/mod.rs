@@ -35,7 +35,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 
-use crate::linalg::sym_eigen;
+use crate::linalg::sym_eigen_ql;
 
 /// Largest accepted condition number of the covariance matrix (ratio of its largest to
 /// its smallest eigenvalue). Beyond it the smallest axes are lost to rounding in
@@ -495,7 +495,7 @@ impl Cmaes {
     /// Recomputes B and D from C and records whether C is too ill-conditioned.
     fn update_eigensystem(&mut self) {
         let n = self.n;
-        sym_eigen(
+        sym_eigen_ql(
             n,
             &self.c,
             &mut self.eigenvalues,

@@ -70,12 +70,13 @@ fn rosenbrock_10d_reaches_1e_minus_10_in_most_runs() {
 /// Rastrigin, n = 10, lambda = 400, start mean uniform in [1, 5]^10 (a box that
 /// excludes the optimum) and sigma0 = 2, in the style of Hansen & Kern (2004): a
 /// large population smooths out the local minima so that most runs find the global
-/// optimum. pycma 4.5.0 without active CMA finds it in 19 of 21 runs with this
-/// setup, as does this implementation; 4 of these 5 seeds must succeed.
+/// optimum. pycma 4.5.0 without active CMA finds it in 19 of 21 runs with this setup;
+/// this implementation in 178 of 200 seeds (182 with the Jacobi eigensolver); 15 of
+/// these 20 seeds must succeed.
 #[test]
 fn rastrigin_10d_large_population_finds_global_optimum() {
     let mut successes = 0;
-    for seed in 0..5 {
+    for seed in 0..20 {
         let x0 = start_in_box(seed, 10, 1.0, 5.0);
         let config = CmaesConfig {
             population: Some(400),
@@ -88,8 +89,8 @@ fn rastrigin_10d_large_population_finds_global_optimum() {
         }
     }
     assert!(
-        successes >= 4,
-        "only {successes}/5 runs found the global optimum"
+        successes >= 15,
+        "only {successes}/20 runs found the global optimum"
     );
 }
 
