@@ -81,8 +81,7 @@ pub struct FlightConfig {
     /// `docs/flight.md` for the table). At 2.9e-5 rad a corner 0.15 m from the centre
     /// moves 4 um, a few hundredths of the examples' smallest pixel (1.5 mm) and 300
     /// times less than a launcher's orientation error (0.5 deg); 0.02 rad made the error
-    /// 40 times smaller still for 2.5 times the steps, the largest share of a block
-    /// solve's time.
+    /// 40 times smaller still for 2.5 times the steps, a fifth of fly's solve.
     pub rk4_max_angle: f64,
 }
 
