@@ -69,24 +69,8 @@ pub fn sym_eigen(n: usize, a: &[f64], values: &mut [f64], vectors: &mut [f64], w
     for i in 0..n {
         values[i] = m[i * n + i];
     }
+    sort_ascending(n, values, vt);
     transpose(n, vt);
-    let v = vt;
-    // Sort eigenpairs ascending with a selection sort: n is small and this keeps the
-    // routine allocation-free.
-    for i in 0..n {
-        let mut best = i;
-        for j in (i + 1)..n {
-            if values[j] < values[best] {
-                best = j;
-            }
-        }
-        if best != i {
-            values.swap(i, best);
-            for k in 0..n {
-                v.swap(k * n + i, k * n + best);
-            }
-        }
-    }
 }
 
 /// Eigen-decomposition of the symmetric `n x n` matrix `a` (row-major, only read, and
@@ -114,21 +98,26 @@ pub fn sym_eigen_ql(
     // QL rotates pairs of columns of V: as rows of V^T they are contiguous.
     transpose(n, v);
     tridiagonal_ql(n, v, d, e);
-    // Ascending, by selection (the rows of V^T move with their values).
+    sort_ascending(n, d, v);
+    transpose(n, v);
+}
+
+/// Sort the eigenvalues `values[..n]` ascending, the rows of `vt` (the eigenvectors, as
+/// rows of V^T) with them: a selection sort, allocation-free, and n is small.
+fn sort_ascending(n: usize, values: &mut [f64], vt: &mut [f64]) {
     for i in 0..n {
         let mut best = i;
         for j in (i + 1)..n {
-            if d[j] < d[best] {
+            if values[j] < values[best] {
                 best = j;
             }
         }
         if best != i {
-            d.swap(i, best);
-            let (head, tail) = v.split_at_mut(best * n);
+            values.swap(i, best);
+            let (head, tail) = vt.split_at_mut(best * n);
             head[i * n..(i + 1) * n].swap_with_slice(&mut tail[..n]);
         }
     }
-    transpose(n, v);
 }
 
 /// `tred2`: `v` (holding the matrix, row-major) becomes the orthogonal `V` with
@@ -397,26 +386,8 @@ mod tests {
 
     #[test]
     fn matches_the_reference_jacobi_bit_for_bit() {
-        let mut s = 99u64;
         for n in [3, 10, 50, 96] {
-            // A covariance-like matrix: B^T B plus a diagonal, exactly symmetric.
-            let r: Vec<f64> = (0..n * n)
-                .map(|_| {
-                    s = s
-                        .wrapping_mul(6364136223846793005)
-                        .wrapping_add(1442695040888963407);
-                    ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-                })
-                .collect();
-            let mut a = vec![0.0; n * n];
-            for i in 0..n {
-                for j in i..n {
-                    let x: f64 = (0..n).map(|k| r[k * n + i] * r[k * n + j]).sum::<f64>()
-                        + if i == j { 0.1 } else { 0.0 };
-                    a[i * n + j] = x;
-                    a[j * n + i] = x;
-                }
-            }
+            let a = covariance(n, 99 + n as u64, 0.1);
             let (want_values, want_vectors) = reference(n, &a);
             let (mut values, mut vectors, mut work) =
                 (vec![0.0; n], vec![0.0; n * n], vec![0.0; n * n]);
