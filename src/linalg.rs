@@ -74,8 +74,9 @@ pub fn sym_eigen(n: usize, a: &[f64], values: &mut [f64], vectors: &mut [f64], w
 }
 
 /// Eigen-decomposition of the symmetric `n x n` matrix `a` (row-major, only read, and
-/// only its lower triangle), with [`sym_eigen`]'s convention: `values` ascending, column `k` of `vectors` (row-major)
-/// the unit eigenvector of `values[k]`; `work` must hold `n` values. Householder
+/// only its lower triangle), with [`sym_eigen`]'s convention: `values` ascending, column
+/// `k` of `vectors` (row-major) the unit eigenvector of `values[k]`; `work` must hold `n`
+/// values. Householder
 /// reduction to a tridiagonal matrix, then implicit QL with shifts on it (Bowdler,
 /// Martin, Reinsch and Wilkinson's `tred2` and `tql2`, as JAMA writes them). Nothing is
 /// allocated. A matrix with a non-finite entry gives non-finite values (each eigenvalue
@@ -454,8 +455,7 @@ mod tests {
         for (n, seed) in [(1, 1), (2, 2), (3, 3), (10, 4), (50, 5), (96, 6), (200, 7)] {
             let a = covariance(n, seed, 0.1);
             let values = ql_checked(n, &a, 1e-12);
-            let (want, mut v, mut w) = (vec![0.0; n], vec![0.0; n * n], vec![0.0; n * n]);
-            let mut want = want;
+            let (mut want, mut v, mut w) = (vec![0.0; n], vec![0.0; n * n], vec![0.0; n * n]);
             sym_eigen(n, &a, &mut want, &mut v, &mut w);
             for (x, y) in values.iter().zip(&want) {
                 assert!((x - y).abs() <= 1e-12 * want[n - 1], "n = {n}: {x} vs {y}");

@@ -24,7 +24,8 @@ pub const CHORD_STEPS: usize = 6;
 
 /// Rotation per RK4 step (rad, at the fastest the body's spin may get) of the coarse
 /// flight on which [`Spin::reaching`] runs Newton's method: about 1e-4 of the turn's
-/// error at `t`, at a fifth of the cost of the flight's own steps of 0.02 rad.
+/// error at `t`, at half the cost of the flight's own steps of 0.05 rad (a fifth when
+/// those were 0.02 rad).
 pub const COARSE_ANGLE: f64 = 0.1;
 
 /// A body's turn in free flight: from `from` at launch, over `t` seconds of `flight`.
