@@ -429,9 +429,9 @@ struct DesignArgs {
     /// boxwood). `auto:` items let `bsa new` choose how many, adding objects while one more
     /// raises the picture's IoU by half a point: `auto:sphere` (the radii chosen too),
     /// `auto:sphere:R`, `auto:box:XxYxZ`, `auto:mesh:FILE.obj[@SCALE]` or `auto:chess`
-    /// (pieces of one side), up to 32 objects; several of them make a box of several sizes
-    /// (each but `auto:chess` with an optional `*N`, the most it adds; counts that add up
-    /// to more raise the cap to their sum). Or FILE.json: an array of
+    /// (pieces of one side), up to 64 balls or 32 other objects (a ball counts half);
+    /// several of them make a box of several sizes (each but `auto:chess` with an optional
+    /// `*N`, the most it adds; counts that add up to more raise the cap to their sum). Or FILE.json: an array of
     /// {"kind": "sphere" | "box" | "mesh" | "chess", "radius", "size": [X, Y, Z], "obj",
     /// "scale", "piece", "count": N | "auto", "at_most", "density"}, its mesh paths
     /// relative to its folder. `bsa plant` takes neither `auto:` items nor chess pieces by name

@@ -74,7 +74,8 @@ pub fn thin_parts(picture: &Picture, frame: &Frame, request: &Request) -> Option
 
 /// The most an automatic inventory widens the picture ([`auto_width`]): twice the
 /// width is four times the area, and the count grows with the area up to the cap of
-/// [`super::AUTO_CAP`] objects; beyond, the note tells the width and leaves it to the user.
+/// [`super::AUTO_CAP`] balls (half as many other objects); beyond, the note tells the width
+/// and leaves it to the user.
 const MOST_WIDENING: f64 = 2.0;
 
 /// A width (m) up to the centimetre above, so that the width said is enough.
@@ -146,7 +147,7 @@ pub fn note(
     }
     let advice = match auto {
         None => "more objects, or objects shaped more like its parts (auto:box:XxYxZ, auto:sphere or auto:chess lets bsa new choose how many, and several auto:box items which sizes)".to_string(),
-        Some(AutoStop::Cap(n)) => format!("more objects than auto: adds (it stops at its cap of {n}): a count above it on the auto: item (such as auto:sphere*{}) raises the cap, each object adding to the solve's time", 2 * n),
+        Some(AutoStop::Cap(n)) => format!("more objects than auto: adds (it stops at its cap, here {n} objects): a count above it on the auto: item (such as auto:sphere*{}) raises the cap, each object adding to the solve's time", 2 * n),
         Some(_) => "objects of a size that fits its bare parts (another auto: item of a smaller size)".to_string(),
     };
     Some(format!(

@@ -35,10 +35,11 @@ impl Cover<'_> {
     }
 
     /// Undo the greedy's other short sight, which object goes where: for every two
-    /// placements of objects of different shapes (`same` tells identical ones), each
-    /// object is tried on the other's place (every pose family and roll of its own, the
-    /// other's direction either way round, the magnification that gives the other's
-    /// area, then refined) and the exchange is kept when the two gain more together.
+    /// placements of objects of different shapes (`same` tells those of one shape up to
+    /// scale), each object is tried on the other's place (every pose family and roll of
+    /// its own, the other's direction either way round, the magnification that gives the
+    /// other's area, then refined) and the exchange is kept when the two gain more
+    /// together.
     /// Largest first, the greedy gives the largest object the place it covers best at
     /// any magnification, which is often a smaller object's place (a king on the
     /// queen's silhouette). `families[k]` are placement `k`'s object's pose families.
