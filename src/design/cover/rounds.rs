@@ -35,8 +35,8 @@ impl Cover<'_> {
     }
 
     /// Undo the greedy's other short sight, which object goes where: for every two
-    /// placements of objects of different shapes (`same` tells those of one shape up to
-    /// scale), each object is tried on the other's place (every pose family and roll of
+    /// placements of objects of different shapes (`same` tells those an exchange cannot
+    /// improve), each object is tried on the other's place (every pose family and roll of
     /// its own, the other's direction either way round, the magnification that gives the
     /// other's area, then refined) and the exchange is kept when the two gain more
     /// together.
