@@ -239,8 +239,8 @@ pub fn check_dark_part(
 
 /// Design a scene: place every object's shadow on `picture` (in `order`), add objects
 /// of the `auto:` kind while they gain enough, exchange objects of different shapes
-/// (not two balls made to measure) where both fit better, with `replace` place each object anew where
-/// it gains more ([`Cover::replace`]), polish, and plan the launches.
+/// (not two balls made to measure) where both fit better, with `replace` place each
+/// object anew where it gains more ([`Cover::replace`]), polish, and plan the launches.
 pub fn design(
     picture: &Picture,
     geometry: Geometry,
