@@ -1,7 +1,8 @@
 //! Composing a scene from a picture and a box of objects: the design search of
 //! `bsa new` ([`Search::run`]), the picture designed under every
-//! [`Setting`] (each of [`crate::design::CEILINGS`] in each of [`ORDERS`]), each design made
-//! contact-free ([`separate`]); the designs that differ from those before them then
+//! [`Setting`] (each of [`crate::design::CEILINGS`] in each of [`ORDERS`], once for
+//! both orders where they make the same design), each design made contact-free
+//! ([`separate`]); the designs that differ from those before them then
 //! race ([`race`]) and the best ([`Variant::better_than`]) is kept ([`Found`]). When no
 //! design's solve reaches [`REPLACE_BELOW`], a second round designs again under the
 //! ceilings of the best designs ([`crate::design::ANEW_CEILINGS`]) with the objects
@@ -103,6 +104,7 @@ impl Solved {
 }
 
 /// One design of the picture under one setting, made contact-free.
+#[derive(Clone)]
 pub struct Variant {
     pub plan: Plan,
     pub setting: Setting,
@@ -308,17 +310,42 @@ impl Search<'_> {
                 if replace { ", objects placed anew" } else { "" }
             ),
         );
-        let made: Vec<Result<Variant, SearchError>> = ks
-            .clone()
+        // Where the orders make the same design, each is made once.
+        let twin = |k: usize| {
+            let (a, b) = (settings[k], |j: usize| settings[j]);
+            (ks.start..k).find(|&j| {
+                self.request.one_order() && b(j).ceiling == a.ceiling && b(j).replace == a.replace
+            })
+        };
+        let todo: Vec<usize> = ks.clone().filter(|&k| twin(k).is_none()).collect();
+        let mut made: Vec<Option<Result<Variant, SearchError>>> =
+            ks.clone().map(|_| None).collect();
+        let done: Vec<(usize, Result<Variant, SearchError>)> = todo
             .into_par_iter()
             .map(|k| {
                 let variant = unless_interrupted(interrupts, || self.design(settings[k], k));
                 watch.step();
-                variant
+                (k, variant)
             })
             .collect();
+        for (k, v) in done {
+            made[k - ks.start] = Some(v);
+        }
+        for k in ks.clone() {
+            if let Some(j) = twin(k) {
+                let v = match &made[j - ks.start] {
+                    Some(Ok(v)) => Ok(Variant {
+                        setting: settings[k],
+                        ..v.clone()
+                    }),
+                    _ => unless_interrupted(interrupts, || self.design(settings[k], k)),
+                };
+                made[k - ks.start] = Some(v);
+                watch.step();
+            }
+        }
         watch.end();
-        designed.extend(made);
+        designed.extend(made.into_iter().map(|v| v.expect("every setting designed")));
         let scenes: Vec<Option<String>> = designed
             .iter()
             .map(|v| {
