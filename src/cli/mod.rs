@@ -427,7 +427,7 @@ struct DesignArgs {
     /// rook, bishop, knight or pawn) and `chess` (one side of it, 16 pieces). Each takes an
     /// optional `*N` count and `/DENSITY` in kg/m^3 (default 705, maple; chess pieces 900,
     /// boxwood). `auto:` items let `bsa new` choose how many, adding objects while one more
-    /// raises the picture's IoU by half a point: `auto:sphere` (the radii chosen too),
+    /// raises the picture's IoU by a quarter of a point: `auto:sphere` (the radii chosen too),
     /// `auto:sphere:R`, `auto:box:XxYxZ`, `auto:mesh:FILE.obj[@SCALE]` or `auto:chess`
     /// (pieces of one side), up to 64 balls or 32 other objects (a ball counts half);
     /// several of them make a box of several sizes (each but `auto:chess` with an optional
