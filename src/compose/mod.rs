@@ -310,34 +310,37 @@ impl Search<'_> {
                 if replace { ", objects placed anew" } else { "" }
             ),
         );
-        // Where the orders make the same design, each is made once.
-        let twin = |k: usize| {
-            let (a, b) = (settings[k], |j: usize| settings[j]);
-            (ks.start..k).find(|&j| {
-                self.request.one_order() && b(j).ceiling == a.ceiling && b(j).replace == a.replace
-            })
-        };
-        let todo: Vec<usize> = ks.clone().filter(|&k| twin(k).is_none()).collect();
-        let mut made: Vec<Option<Result<Variant, SearchError>>> =
-            ks.clone().map(|_| None).collect();
-        let done: Vec<(usize, Result<Variant, SearchError>)> = todo
-            .into_par_iter()
+        // Where the orders make the same design, each is made once: a setting's twin is
+        // the first before it under the same ceiling and replace.
+        let one = self.request.one_order();
+        let twin: Vec<Option<usize>> = ks
+            .clone()
             .map(|k| {
-                let variant = unless_interrupted(interrupts, || self.design(settings[k], k));
-                watch.step();
-                (k, variant)
+                let s = settings[k];
+                (ks.start..k).find(|&j| {
+                    one && settings[j].ceiling == s.ceiling && settings[j].replace == s.replace
+                })
             })
             .collect();
-        for (k, v) in done {
-            made[k - ks.start] = Some(v);
-        }
+        let mut made: Vec<Option<Result<Variant, SearchError>>> = ks
+            .clone()
+            .into_par_iter()
+            .map(|k| {
+                twin[k - ks.start].is_none().then(|| {
+                    let variant = unless_interrupted(interrupts, || self.design(settings[k], k));
+                    watch.step();
+                    variant
+                })
+            })
+            .collect();
         for k in ks.clone() {
-            if let Some(j) = twin(k) {
+            if let Some(j) = twin[k - ks.start] {
                 let v = match &made[j - ks.start] {
                     Some(Ok(v)) => Ok(Variant {
                         setting: settings[k],
                         ..v.clone()
                     }),
+                    // The twin's error, made again (errors do not clone).
                     _ => unless_interrupted(interrupts, || self.design(settings[k], k)),
                 };
                 made[k - ks.start] = Some(v);
