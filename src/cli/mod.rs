@@ -431,8 +431,9 @@ struct DesignArgs {
     /// `auto:sphere:R`, `auto:box:XxYxZ`, `auto:mesh:FILE.obj[@SCALE]` or `auto:chess`
     /// (pieces of one side), up to 64 balls or 32 other objects (a ball counts half);
     /// several of them make a box of several sizes (each but `auto:chess` with an optional
-    /// `*N`, the most it adds; counts that add up to more raise the cap to their sum). Or
-    /// FILE.json: an array of
+    /// `*N`, the most it adds; counts that add up to more raise the cap to their sum). An
+    /// `auto:` item of a given size has its designs flown lower (ceilings 0.6 to 0.3 of
+    /// the light's height), so that its shadows keep near its size. Or FILE.json: an array of
     /// {"kind": "sphere" | "box" | "mesh" | "chess", "radius", "size": [X, Y, Z], "obj",
     /// "scale", "piece", "count": N | "auto", "at_most", "density"}, its mesh paths
     /// relative to its folder. `bsa plant` takes neither `auto:` items nor chess pieces by name

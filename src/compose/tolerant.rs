@@ -17,7 +17,6 @@ use serde::Serialize;
 use super::{Search, SearchError, Setting, Solved, Variant, Watch};
 use crate::budget::{self, NEEDS_MARGIN};
 use crate::design::launch::Geometry;
-use crate::design::CEILINGS;
 use crate::evaluate::Problem;
 use crate::output::picture::plot::{FrontierData, FrontierPoint};
 use crate::output::solution::Solution;
@@ -31,7 +30,7 @@ use crate::scene::Launch;
 /// halving of `t` relaxed it by about a third.
 pub const INSTANTS: [f64; 3] = [0.5, 0.25, 0.125];
 /// The highest flights tried with posed launches, as shares of the light's height:
-/// lower than [`CEILINGS`], since a body's miss grows with the length of its flight.
+/// lower than [`crate::design::CEILINGS`], since a body's miss grows with the length of its flight.
 /// Each of these was kept for some of the four examples and the three pictures of set
 /// 25; 0.2 was tried too and dropped: it was kept for none, and leaving its designs
 /// out changed no choice.
@@ -217,7 +216,7 @@ pub fn run(
     interrupts: &AtomicUsize,
 ) -> (Frontier, Result<Variant, SearchError>) {
     let asked = search.geometry;
-    let runs = std::iter::once((asked.clone(), &CEILINGS[..])).chain(INSTANTS.iter().map(|s| {
+    let runs = std::iter::once((asked.clone(), search.ceilings)).chain(INSTANTS.iter().map(|s| {
         let g = Geometry {
             t: s * asked.t,
             posed: true,

@@ -275,6 +275,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let probe_file = dir.join(SCRATCH_PROBE);
     let most_settings = compose::most_designs(&design::CEILINGS)
+        .max(compose::most_designs(&design::AUTO_CEILINGS))
         .max(compose::most_designs(&tolerant::LAUNCHER_CEILINGS));
     let design_files: Vec<PathBuf> = (0..most_settings)
         .map(|k| dir.join(format!(".bsa-new-design-{k}.json")))
@@ -329,7 +330,7 @@ pub(super) fn run(opts: &Options) -> Result<()> {
         target: SCRATCH_TARGET,
         seed: opts.seed,
         trial,
-        ceilings: &design::CEILINGS,
+        ceilings: request.ceilings(),
         launcher: None,
         rounds: 2,
     };
