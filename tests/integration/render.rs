@@ -269,6 +269,14 @@ fn new_refuses_pictures_objects_and_options_it_cannot_use() {
             "--objects: sphere:5 (10.000 m across)",
         ),
         (m, "sphere:1e-9", vec![], "less than one pixel"),
+        // Under a pixel at the lower ceilings of an auto: item of a given size (0.6 of
+        // the light's height), though not at 0.8.
+        (
+            m,
+            "auto:box:0.0004x0.0004x0.0004",
+            vec![],
+            "less than one pixel",
+        ),
         (m, "mesh:Cargo.toml", vec![], "--objects: mesh:"),
         (m, "cube:1", vec![], "unknown kind `cube`"),
         (m, "box:1e300x1x1", vec![], "at most 1000, got 1e300"),

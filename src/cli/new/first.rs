@@ -54,12 +54,12 @@ pub(super) fn first_scene(
     }
     write(probe_file, &probe)?;
     let (scene, light_err) = load_probe(probe_file, &probe, protos, target, write)?;
-    check_sizes(&scene, protos)?;
+    let request = request_of(&scene, protos, (of_item, auto));
+    check_sizes(&scene, protos, request.ceilings()[0])?;
     if let Some(e) = light_err {
         return Err(e);
     }
     check_dark_part(&scene, protos, target)?;
-    let request = request_of(&scene, protos, (of_item, auto));
     let (picture, geometry) = picture_and_geometry(&scene);
     Ok((scene, request, picture, geometry))
 }
@@ -229,12 +229,13 @@ fn check_dark_part(scene: &Scene, protos: &[Prototype], target: &Path) -> Result
 }
 
 /// An object whose shadow is wider than the picture cannot be part of it; one whose
-/// shadow is smaller than a pixel even at the highest ceiling cannot be seen in it.
-fn check_sizes(scene: &Scene, protos: &[Prototype]) -> Result<()> {
+/// shadow is smaller than a pixel even at the request's highest ceiling cannot be seen
+/// in it.
+fn check_sizes(scene: &Scene, protos: &[Prototype], highest: f64) -> Result<()> {
     let pixel = scene.receiver.width / scene.target.width() as f64;
     // A body under the highest ceiling, a share c of the light's height above the
     // picture, casts a shadow 1 / (1 - c) times its size.
-    let magnified = 1.0 / (1.0 - design::CEILINGS[0]);
+    let magnified = 1.0 / (1.0 - highest);
     for (o, p) in scene.occluders.iter().zip(protos) {
         let most = 2.0 * o.bounding_radius * magnified;
         if most < pixel {
