@@ -987,6 +987,38 @@ fn moves_swap_two_bodies_that_cover_each_others_parts() {
     );
 }
 
+/// A move is taken only where it draws a better picture (`moves::improve`): two equal
+/// balls each on the other's part draw the same picture, and sending them back, though
+/// it ranks better (slower launches), mends nothing.
+#[test]
+fn moves_take_no_swap_of_equal_balls_that_draws_the_same_picture() {
+    // Seed 4: the flights of both launches stay apart.
+    let (p, planted) = planted_seed("moves-equal-swap", "sphere:0.25,sphere:0.25", "4", "4");
+    let w = p.scene.stages.last().unwrap().weights;
+    let mut ws = p.workspace();
+    let at_plant = p.evaluate(&planted, &w, &mut ws);
+    let (c0, c1) = (com(&p, &ws, 0), com(&p, &ws, 1));
+    let mut swapped = planted.clone();
+    aim(&p, &mut swapped, 0, c1);
+    aim(&p, &mut swapped, 1, c0);
+    let at_swap = p.evaluate(&swapped, &w, &mut ws);
+    assert_eq!(at_plant.iou, 1.0);
+    assert_eq!(at_swap.iou, 1.0);
+    assert_eq!(at_plant.outcome.n_contacts + at_swap.outcome.n_contacts, 0);
+    // Start from the launch that ranks worse: the other, the swap, ranks better.
+    let (mut params, worse, better) = if at_swap.total > at_plant.total {
+        (swapped, at_swap.total, at_plant.total)
+    } else {
+        (planted, at_plant.total, at_swap.total)
+    };
+    assert!(better < worse, "{better} {worse}");
+    let start = params.clone();
+    let (_, best, report) = run_moves(&p, &mut params, &contact_free_first);
+    assert_eq!(report.accepted, 0, "{report:?}");
+    assert_eq!(params, start);
+    assert_eq!(best.iou, 1.0);
+}
+
 #[test]
 fn bodies_each_small_on_the_others_part_swap_to_the_parts_whole_sizes() {
     // The planted suite's spheres-9400 (`bash scripts/planted-suite.sh 9400 1`): four

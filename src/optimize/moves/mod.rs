@@ -400,7 +400,7 @@ pub fn improve(
         offers.sort_by(|a, b| search.free(&a.eval).total_cmp(&search.free(&b.eval)));
         let mut scratch = Offers::new(&mut search, ws, &mut candidate, &mut flight);
         polish_best(&mut offers, held, &vary, options, &mut scratch);
-        match best_offer(&offers, rank, rank(&current)) {
+        match best_offer(&offers, rank, &current) {
             Some(offer) => {
                 let e = offer.eval;
                 params.copy_from_slice(&offer.launch);
@@ -446,14 +446,23 @@ fn trade_groups<'a>(scene: &Scene, groups: [&'a [usize]; 2], trades: bool) -> Ve
         .collect()
 }
 
-/// The first of the offers that ranks best, if it ranks better than `kept`.
+/// The first of the offers that ranks best, if it ranks better than the launch kept
+/// (`current`) and mends something: it draws a better picture, or the launch kept has a
+/// contact of its own.
+///
+/// A move that draws the same picture mends nothing the runs would not: two equal balls
+/// sent each to the other's part rank better where their launches are slower, and on a
+/// design of 64 balls with a dozen radii such swaps were taken pass after pass, each
+/// pass 4,096 samples of every ball (set 33's jellyfish: the last stage's moves and
+/// polish 57 moves and 31 s for IoU +0.0011; the whole solve 63 s, 26 s without them).
 fn best_offer<'a>(
     offers: &'a [Offer],
     rank: &dyn Fn(&Evaluation) -> f64,
-    kept: f64,
+    current: &Evaluation,
 ) -> Option<&'a Offer> {
-    let mut best = (kept, None);
-    for offer in offers {
+    let mut best = (rank(current), None);
+    let mends = |e: &Evaluation| e.iou > current.iou || current.outcome.own_contact > 0.0;
+    for offer in offers.iter().filter(|o| mends(&o.eval)) {
         let r = rank(&offer.eval);
         if r < best.0 {
             best = (r, Some(offer));
