@@ -19,6 +19,7 @@ import os
 import re
 import struct
 import sys
+import tempfile
 import time
 import zlib
 
@@ -40,6 +41,12 @@ def script_argv():
 def result(value):
     """Print the machine-readable result line that `bsa` looks for."""
     print(RESULT_PREFIX + json.dumps(value), flush=True)
+
+
+def scratch_dir(prefix):
+    """A temporary folder for renders, removed with everything in it when the `with` block
+    ends, by a result, a failure (`fail` exits) or an exception alike."""
+    return tempfile.TemporaryDirectory(prefix=prefix, ignore_cleanup_errors=True)
 
 
 def fail(msg, code=2):

@@ -25,7 +25,6 @@ import argparse
 import math
 import os
 import sys
-import tempfile
 
 sys.dont_write_bytecode = True
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -193,21 +192,21 @@ def main():
                                       for o in bpy.data.objects if o.type == "CURVE"),
         "collections": sorted(c.name for c in scene.collection.children),
     }
-    tmp = tempfile.mkdtemp(prefix="bsa_check_blend_")
-    if args.mask:
-        frame = args.frame if args.frame is not None else t_frame
-        report["mask"] = shadow_mask(bpy, np, shadow, args.engine, frame, args.mask,
-                                     args.eevee_samples, tmp)
-    if not args.no_view:
-        try:
-            w, h = (int(v) for v in args.view_size.lower().split("x"))
-        except ValueError:
-            B.fail("--view-size must be WxH, got %r" % args.view_size)
-        activate(bpy, scene)
-        B.set_frame(scene, t_frame)
-        report["view"] = view_fraction(bpy, np, scene, (w, h), tmp)
-    report["seconds"] = timer()
-    B.result(report)
+    with B.scratch_dir("bsa_check_blend_") as tmp:
+        if args.mask:
+            frame = args.frame if args.frame is not None else t_frame
+            report["mask"] = shadow_mask(bpy, np, shadow, args.engine, frame, args.mask,
+                                         args.eevee_samples, tmp)
+        if not args.no_view:
+            try:
+                w, h = (int(v) for v in args.view_size.lower().split("x"))
+            except ValueError:
+                B.fail("--view-size must be WxH, got %r" % args.view_size)
+            activate(bpy, scene)
+            B.set_frame(scene, t_frame)
+            report["view"] = view_fraction(bpy, np, scene, (w, h), tmp)
+        report["seconds"] = timer()
+        B.result(report)
 
 
 if __name__ == "__main__":

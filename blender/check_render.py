@@ -21,7 +21,6 @@ ratio = lit_mean / shadow_mean, black (true if the lit level is under 0.05), sec
 import argparse
 import os
 import sys
-import tempfile
 from time import perf_counter as timer
 
 sys.dont_write_bytecode = True
@@ -75,13 +74,13 @@ def main():
     scene.cycles.filter_width = 0.01
     B.set_frame(scene, frame)
 
-    tmpdir = tempfile.mkdtemp(prefix="bsa_check_render_")
-    raw = args.keep_render or os.path.join(tmpdir, "render.png")
-    B.image_output(scene, raw)
-    t0 = timer()
-    bpy.ops.render.render(write_still=True)
-    t_render = timer() - t0
-    px = B.load_pixels(raw)
+    with B.scratch_dir("bsa_check_render_") as tmpdir:
+        raw = args.keep_render or os.path.join(tmpdir, "render.png")
+        B.image_output(scene, raw)
+        t0 = timer()
+        bpy.ops.render.render(write_still=True)
+        t_render = timer() - t0
+        px = B.load_pixels(raw)
     if px.shape[:2] != (h, w):
         B.fail("render size %r != %dx%d" % (px.shape[:2], w, h))
     luma = 0.2126 * px[..., 0] + 0.7152 * px[..., 1] + 0.0722 * px[..., 2]

@@ -19,7 +19,6 @@ Shadow pixel = alpha > 0.5 and Rec. 709 luma < 0.5.
 import argparse
 import os
 import sys
-import tempfile
 
 sys.dont_write_bytecode = True  # keep blender/ free of __pycache__
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -179,8 +178,6 @@ def main():
     B.set_frame(scene, frame)
 
     # Render to a temporary PNG, read it back.
-    tmpdir = tempfile.mkdtemp(prefix="bsa_shadow_")
-    raw_path = os.path.join(tmpdir, "render.png")
     im = r.image_settings
     if hasattr(im, "media_type"):  # bpy 5.0
         im.media_type = "IMAGE"
@@ -188,32 +185,29 @@ def main():
     im.color_mode = "RGBA"
     im.color_depth = "8"
     im.compression = 0
-    r.filepath = raw_path
     r.use_file_extension = False
-    t0 = timer()
-    bpy.ops.render.render(write_still=True)
-    t_render = round(timer() - t0, 3)
-    if not os.path.exists(raw_path):
-        B.fail("Cycles did not write %s" % raw_path)
-    img = bpy.data.images.load(raw_path)
-    if tuple(img.size) != (width, height):
-        B.fail("render size %r != %dx%d" % (tuple(img.size), width, height))
-    px = np.empty(width * height * 4, dtype=np.float32)
-    img.pixels.foreach_get(px)
+    with B.scratch_dir("bsa_shadow_") as tmpdir:
+        raw_path = os.path.join(tmpdir, "render.png")
+        r.filepath = raw_path
+        t0 = timer()
+        bpy.ops.render.render(write_still=True)
+        t_render = round(timer() - t0, 3)
+        if not os.path.exists(raw_path):
+            B.fail("Cycles did not write %s" % raw_path)
+        if args.keep_render:
+            import shutil
+            shutil.copyfile(raw_path, args.keep_render)
+        img = bpy.data.images.load(raw_path)
+        if tuple(img.size) != (width, height):
+            B.fail("render size %r != %dx%d" % (tuple(img.size), width, height))
+        px = np.empty(width * height * 4, dtype=np.float32)
+        img.pixels.foreach_get(px)
+        bpy.data.images.remove(img)
     px = px.reshape(height, width, 4)[::-1]  # Image.pixels rows run bottom-up
     luma = 0.2126 * px[..., 0] + 0.7152 * px[..., 1] + 0.0722 * px[..., 2]
     shadow = (px[..., 3] > 0.5) & (luma < 0.5)
     mask = np.where(shadow, 0, 255).astype(np.uint8)
     B.write_gray_png(args.out, mask.tobytes(), width, height)
-    if args.keep_render:
-        import shutil
-        shutil.copyfile(raw_path, args.keep_render)
-    bpy.data.images.remove(img)
-    try:
-        os.remove(raw_path)
-        os.rmdir(tmpdir)
-    except OSError:
-        pass
 
     for w in warnings:
         sys.stderr.write("warning: %s\n" % w)

@@ -16,7 +16,6 @@ import json
 import os
 import shutil
 import sys
-import tempfile
 
 sys.dont_write_bytecode = True  # keep blender/ free of __pycache__
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -101,20 +100,19 @@ def main():
         ff.ffmpeg_preset = "GOOD"
         ff.gopsize = max(1, int(round(fps)))
         ff.audio_codec = "NONE"
-        tmpdir = tempfile.mkdtemp(prefix="bsa_video_")
-        r.filepath = os.path.join(tmpdir, "video.mp4")
-        r.use_file_extension = True
-        t0 = timer()
-        bpy.ops.render.render(animation=True)
-        t_render = round(timer() - t0, 3)
-        cands = [os.path.join(tmpdir, f) for f in os.listdir(tmpdir)]
-        produced = max(cands, key=os.path.getsize) if cands else None
-        if produced is None or os.path.getsize(produced) == 0:
-            B.fail("Blender wrote no video (looked in %s)" % tmpdir)
-        video = os.path.abspath(args.out)
-        os.makedirs(os.path.dirname(video), exist_ok=True)
-        shutil.move(produced, video)
-        shutil.rmtree(tmpdir, ignore_errors=True)
+        with B.scratch_dir("bsa_video_") as tmpdir:
+            r.filepath = os.path.join(tmpdir, "video.mp4")
+            r.use_file_extension = True
+            t0 = timer()
+            bpy.ops.render.render(animation=True)
+            t_render = round(timer() - t0, 3)
+            cands = [os.path.join(tmpdir, f) for f in os.listdir(tmpdir)]
+            produced = max(cands, key=os.path.getsize) if cands else None
+            if produced is None or os.path.getsize(produced) == 0:
+                B.fail("Blender wrote no video (looked in %s)" % tmpdir)
+            video = os.path.abspath(args.out)
+            os.makedirs(os.path.dirname(video), exist_ok=True)
+            shutil.move(produced, video)
 
     B.result({
         "video": video,

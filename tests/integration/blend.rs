@@ -9,7 +9,8 @@
 use std::path::Path;
 
 use crate::util::{
-    blender_script, bsa, last_key_time, root, shared_full_solve, shared_quick_solve,
+    blender_script, bsa, bsa_leaving_no_temporaries, last_key_time, root, shared_full_solve,
+    shared_quick_solve,
 };
 
 /// `bsa blend <dir> <args>`; the .blend written.
@@ -196,7 +197,7 @@ fn slow_motion_keeps_the_picture_on_screen_and_curves_cast_no_shadow() {
 fn video_writes_an_mp4_and_a_contact_sheet() {
     let dir = shared_quick_solve("mickey");
     let mp4 = dir.join("short.mp4");
-    let (ok, stdout, err) = bsa(&[
+    let (ok, stdout, err) = bsa_leaving_no_temporaries(&[
         "video",
         dir.to_str().unwrap(),
         "--out",

@@ -7,8 +7,8 @@
 use bsa::evaluate::Problem;
 
 use crate::util::{
-    blender_script, bsa, example_scenes, last_key_time, quick_solve, read_json, require, root,
-    shared_quick_solve, tmpdir,
+    blender_script, bsa, bsa_leaving_no_temporaries, example_scenes, last_key_time, quick_solve,
+    read_json, require, root, shared_quick_solve, tmpdir,
 };
 
 #[test]
@@ -17,7 +17,7 @@ fn cycles_mask_matches_the_rasterizer() {
     for scene in example_scenes() {
         let name = scene.file_name().unwrap().to_str().unwrap().to_string();
         let out = shared_quick_solve(&name);
-        let (ok, stdout, err) = bsa(&["validate", out.to_str().unwrap()]);
+        let (ok, stdout, err) = bsa_leaving_no_temporaries(&["validate", out.to_str().unwrap()]);
         assert!(ok, "{err}");
         let v: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join("validate.json")).unwrap())

@@ -28,6 +28,35 @@ pub fn bsa(args: &[&str]) -> (bool, String, String) {
     )
 }
 
+/// [`bsa`] with a temporary folder of its own (`TMPDIR`), which must be empty when it
+/// ends: what it renders through Blender (`validate`, `video`) leaves nothing behind.
+pub fn bsa_leaving_no_temporaries(args: &[&str]) -> (bool, String, String) {
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let scratch = tmpdir(&format!("tmp-bsa-{}-{call}", args[0]));
+    let out = Command::new(env!("CARGO_BIN_EXE_bsa"))
+        .args(args)
+        .current_dir(root())
+        .env("TMPDIR", &*scratch)
+        .output()
+        .expect("run bsa");
+    assert_empty(&scratch, args[0]);
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Fails naming what `who` left in the folder `dir`.
+fn assert_empty(dir: &Path, who: &str) {
+    let left: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert!(left.is_empty(), "{who} left {left:?} in its TMPDIR");
+}
+
 /// `bsa solve SCENE --out OUT -q EXTRA...`, which must succeed; its stdout.
 pub fn solve(scene: &Path, out: &Path, extra: &[&str]) -> String {
     let mut args = vec![
@@ -313,15 +342,23 @@ pub fn shared_full_solve(name: &str) -> SharedDir {
 
 /// Runs `blender/<script> -- <args>` with the bpy venv (which it requires) and returns
 /// the JSON of its `BSA_RESULT` line, refusing a reported error.
+///
+/// The script runs with a temporary folder of its own (`TMPDIR`), which must be empty
+/// when it ends: a script leaves none of its renders behind.
 pub fn blender_script(script: &str, args: &[&str]) -> serde_json::Value {
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let python = root().join(".venv-blender/bin/python");
     require(&python, "bash blender/setup_venv.sh");
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let scratch = tmpdir(&format!("tmp-{script}-{call}"));
     let o = Command::new(python)
         .arg(root().join("blender").join(script))
         .arg("--")
         .args(args)
+        .env("TMPDIR", &*scratch)
         .output()
         .expect("the bpy virtualenv (bash blender/setup_venv.sh)");
+    assert_empty(&scratch, script);
     let stdout = String::from_utf8_lossy(&o.stdout);
     let line = stdout
         .lines()
