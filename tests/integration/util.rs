@@ -16,11 +16,23 @@ pub fn root() -> PathBuf {
 
 /// Runs the `bsa` binary from the repository root: (success, stdout, stderr).
 pub fn bsa(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_bsa"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("run bsa");
+    outcome(bsa_command(args).output().expect("run bsa"))
+}
+
+/// [`bsa`] with a temporary folder of its own ([`leaving_no_temporaries`]): what it
+/// renders through Blender (`validate`, `video`) leaves nothing behind.
+pub fn bsa_leaving_no_temporaries(args: &[&str]) -> (bool, String, String) {
+    outcome(leaving_no_temporaries(&mut bsa_command(args), args[0]).expect("run bsa"))
+}
+
+fn bsa_command(args: &[&str]) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_bsa"));
+    c.args(args).current_dir(root());
+    c
+}
+
+/// Success, stdout and stderr of a finished command.
+fn outcome(out: std::process::Output) -> (bool, String, String) {
     (
         out.status.success(),
         String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -28,33 +40,19 @@ pub fn bsa(args: &[&str]) -> (bool, String, String) {
     )
 }
 
-/// [`bsa`] with a temporary folder of its own (`TMPDIR`), which must be empty when it
-/// ends: what it renders through Blender (`validate`, `video`) leaves nothing behind.
-pub fn bsa_leaving_no_temporaries(args: &[&str]) -> (bool, String, String) {
+/// Runs `cmd` with a temporary folder of its own (`TMPDIR`) and fails, naming `who`, if
+/// anything is left in it when the command ends.
+fn leaving_no_temporaries(cmd: &mut Command, who: &str) -> std::io::Result<std::process::Output> {
     static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let scratch = tmpdir(&format!("tmp-bsa-{}-{call}", args[0]));
-    let out = Command::new(env!("CARGO_BIN_EXE_bsa"))
-        .args(args)
-        .current_dir(root())
-        .env("TMPDIR", &*scratch)
-        .output()
-        .expect("run bsa");
-    assert_empty(&scratch, args[0]);
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-/// Fails naming what `who` left in the folder `dir`.
-fn assert_empty(dir: &Path, who: &str) {
-    let left: Vec<_> = std::fs::read_dir(dir)
+    let scratch = tmpdir(&format!("tmp-{who}-{call}"));
+    let out = cmd.env("TMPDIR", &*scratch).output()?;
+    let left: Vec<_> = std::fs::read_dir(&*scratch)
         .unwrap()
         .map(|e| e.unwrap().file_name())
         .collect();
     assert!(left.is_empty(), "{who} left {left:?} in its TMPDIR");
+    Ok(out)
 }
 
 /// `bsa solve SCENE --out OUT -q EXTRA...`, which must succeed; its stdout.
@@ -346,19 +344,14 @@ pub fn shared_full_solve(name: &str) -> SharedDir {
 /// The script runs with a temporary folder of its own (`TMPDIR`), which must be empty
 /// when it ends: a script leaves none of its renders behind.
 pub fn blender_script(script: &str, args: &[&str]) -> serde_json::Value {
-    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let python = root().join(".venv-blender/bin/python");
     require(&python, "bash blender/setup_venv.sh");
-    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let scratch = tmpdir(&format!("tmp-{script}-{call}"));
-    let o = Command::new(python)
-        .arg(root().join("blender").join(script))
+    let mut cmd = Command::new(python);
+    cmd.arg(root().join("blender").join(script))
         .arg("--")
-        .args(args)
-        .env("TMPDIR", &*scratch)
-        .output()
+        .args(args);
+    let o = leaving_no_temporaries(&mut cmd, script)
         .expect("the bpy virtualenv (bash blender/setup_venv.sh)");
-    assert_empty(&scratch, script);
     let stdout = String::from_utf8_lossy(&o.stdout);
     let line = stdout
         .lines()
