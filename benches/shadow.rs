@@ -9,6 +9,10 @@
 //!   spheres inside the slab, the same spheres straddling the receiver, three rotated
 //!   boxes, a 480-triangle closed UV sphere with and without back-face culling; then
 //!   `xor_count` and `moments` of a three-sphere shadow.
+//! - `raster/six_chess_pieces_silhouette`: the silhouette path of THE THINKER's six
+//!   pieces (504 to 768 triangles each), each at four fixed tumbled poses between the
+//!   light and the receiver, on THE THINKER's 0.96 m x 0.72 m image at 640x480, each
+//!   call on a cleared mask (the shadow a seat scan or a one-piece sample draws).
 
 use std::f64::consts::PI;
 use std::hint::black_box;
@@ -17,7 +21,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use glam::{DQuat, DVec3};
 
 use bsa::shadow::mask::Mask;
-use bsa::shadow::raster::{ImageRect, RasterScratch, ShadowCamera};
+use bsa::shadow::raster::{ClosedMesh, ImageRect, MeshSilhouette, RasterScratch, ShadowCamera};
 
 /// A filled disc of radius `r` pixels centred at `(cx, cy)` on a 640x480 mask.
 fn disc(cx: f64, cy: f64, r: f64) -> Mask {
@@ -170,6 +174,8 @@ fn raster_benches(c: &mut Criterion) {
         })
     });
 
+    chess_bench(&mut group);
+
     mask.clear();
     for (c, r) in spheres {
         cam.rasterize_sphere(c, r, &mut mask);
@@ -183,6 +189,67 @@ fn raster_benches(c: &mut Criterion) {
         b.iter(|| black_box(&mask).moments().count as u64)
     });
     group.finish();
+}
+
+/// `raster/six_chess_pieces_silhouette` (see the module doc).
+fn chess_bench(group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>) {
+    let cam = ShadowCamera::new(
+        DVec3::new(0.0, 0.0, 3.0),
+        ImageRect {
+            center: DVec3::ZERO,
+            u: DVec3::X,
+            v: DVec3::Y,
+            width_m: 0.96,
+            height_m: 0.72,
+            width_px: 640,
+            height_px: 480,
+        },
+    );
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/thinker/pieces");
+    let pieces: Vec<_> = ["pawn", "rook", "knight", "bishop", "queen", "king"]
+        .iter()
+        .map(|name| {
+            let mesh = bsa::geometry::shape::load_obj(&dir.join(format!("{name}.obj")), 1.0)
+                .expect("the thinker's pieces load");
+            let sil = MeshSilhouette::new(&mesh.vertices, &mesh.triangles).expect("closed");
+            (mesh, sil)
+        })
+        .collect();
+    let poses: Vec<(DVec3, DQuat)> = (0..4)
+        .map(|k| {
+            let k = k as f64;
+            (
+                DVec3::new(0.1 * k - 0.15, 0.05 * k - 0.08, 0.8 + 0.4 * k),
+                DQuat::from_euler(glam::EulerRot::XYZ, 0.7 * k + 0.2, 0.4 * k - 0.5, 1.1 * k),
+            )
+        })
+        .collect();
+    let mut mask = Mask::new(640, 480);
+    let mut scratch = RasterScratch::default();
+    let mut world = Vec::new();
+    group.bench_function("six_chess_pieces_silhouette", |b| {
+        b.iter(|| {
+            for (mesh, sil) in &pieces {
+                for &(p, q) in &poses {
+                    mask.clear();
+                    let closed = ClosedMesh {
+                        vertices: &mesh.vertices,
+                        triangles: &mesh.triangles,
+                        silhouette: sil,
+                    };
+                    cam.rasterize_mesh(
+                        black_box(p),
+                        q,
+                        closed,
+                        &mut world,
+                        &mut mask,
+                        &mut scratch,
+                    );
+                }
+            }
+            mask.count()
+        })
+    });
 }
 
 criterion_group!(shadow_benches, mask_benches, raster_benches);

@@ -138,8 +138,8 @@ pub struct RasterScratch {
     pub(super) sil_pix: Vec<DVec2>,
     pub(super) current: u32,
     /// Silhouette edges of the current mesh, and their crossings bucketed by row (a
-    /// counting sort: `row_start` holds each row's first slot in `crossings`).
+    /// counting sort: `row_ends` holds each row's end in `crossings`).
     pub(super) sil_edges: Vec<SilEdge>,
-    pub(super) row_start: Vec<u32>,
+    pub(super) row_ends: Vec<u32>,
     pub(super) crossings: Vec<(f64, i32)>,
 }

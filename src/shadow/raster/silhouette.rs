@@ -214,42 +214,63 @@ impl ShadowCamera {
     /// winding number is non-zero is filled.
     #[inline]
     fn fill_silhouette(&self, r0: usize, r1: usize, mask: &mut Mask, scratch: &mut RasterScratch) {
-        // Counting sort of the crossings by row.
         let rows = r1 - r0 + 1;
-        scratch.row_start.clear();
-        scratch.row_start.resize(rows + 1, 0);
-        for e in &scratch.sil_edges {
-            for j in e.j0..=e.j1 {
-                scratch.row_start[j as usize - r0 + 1] += 1;
+        let RasterScratch {
+            sil_edges,
+            row_ends: ends,
+            crossings,
+            ..
+        } = scratch;
+        // Counting sort of the crossings by row. An edge adds one crossing to each of its
+        // rows: +1 at its first row and -1 past its last (wrapping, the sums come out
+        // right), summed once for the rows' counts and again for their first slots.
+        ends.clear();
+        ends.resize(rows + 2, 0);
+        for e in sil_edges.iter() {
+            let first = &mut ends[e.j0 as usize - r0 + 1];
+            *first = first.wrapping_add(1);
+            let past = &mut ends[e.j1 as usize - r0 + 2];
+            *past = past.wrapping_sub(1);
+        }
+        for _ in 0..2 {
+            for k in 1..=rows {
+                ends[k] = ends[k].wrapping_add(ends[k - 1]);
             }
         }
-        for k in 0..rows {
-            scratch.row_start[k + 1] += scratch.row_start[k];
-        }
-        let total = scratch.row_start[rows] as usize;
-        scratch.crossings.clear();
-        scratch.crossings.resize(total, (0.0, 0));
-        // `row_start[k]` serves as the fill cursor of row k, then is restored.
-        for e in &scratch.sil_edges {
+        crossings.clear();
+        crossings.resize(ends[rows] as usize, (0.0, 0));
+        // `ends[k]`, the first slot of row k, is its fill cursor: after the fill it is
+        // the end of row k.
+        for e in sil_edges.iter() {
             for j in e.j0..=e.j1 {
-                let k = j as usize - r0;
-                let slot = scratch.row_start[k] as usize;
-                scratch.row_start[k] += 1;
+                let slot = &mut ends[j as usize - r0];
                 let x = e.top.x + (j as f64 + 0.5 - e.top.y) * e.slope;
-                scratch.crossings[slot] = (x, e.dir);
+                crossings[*slot as usize] = (x, e.dir);
+                *slot += 1;
             }
         }
-        for k in (1..=rows).rev() {
-            scratch.row_start[k] = scratch.row_start[k - 1];
-        }
-        scratch.row_start[0] = 0;
         let last = (self.width_px - 1) as f64;
-        for k in 0..rows {
-            let (a, b) = (
-                scratch.row_start[k] as usize,
-                scratch.row_start[k + 1] as usize,
+        let span = |mask: &mut Mask, y: usize, enter: f64, exit: f64| {
+            let (lo, hi) = (
+                (enter - 0.5).ceil().max(0.0),
+                (exit - 0.5).floor().min(last),
             );
-            let row = &mut scratch.crossings[a..b];
+            if lo <= hi {
+                mask.fill_span(y, lo as usize, hi as usize);
+            }
+        };
+        let mut a = 0;
+        for (k, &end) in ends[..rows].iter().enumerate() {
+            let row = &mut crossings[a..end as usize];
+            a = end as usize;
+            // Most rows cross one outline, in and out: the span between.
+            if let [(x0, d0), (x1, d1)] = *row {
+                if d0 + d1 == 0 {
+                    let (enter, exit) = if x1 < x0 { (x1, x0) } else { (x0, x1) };
+                    span(mask, r0 + k, enter, exit);
+                    continue;
+                }
+            }
             // Rows hold a handful of crossings: insertion sort by x.
             for i in 1..row.len() {
                 let mut j = i;
@@ -266,10 +287,7 @@ impl ShadowCamera {
                 if before == 0 && winding != 0 {
                     enter = x;
                 } else if before != 0 && winding == 0 {
-                    let (lo, hi) = ((enter - 0.5).ceil().max(0.0), (x - 0.5).floor().min(last));
-                    if lo <= hi {
-                        mask.fill_span(r0 + k, lo as usize, hi as usize);
-                    }
+                    span(mask, r0 + k, enter, x);
                 }
             }
         }
