@@ -313,3 +313,28 @@ fn covariance_stays_symmetric() {
         }
     }
 }
+
+/// The eigen gap of purecma, in generations: every generation for a one-body run of the
+/// examples (n = 6, lambda 12), every second for n = 10, lambda = 10, every twelfth for
+/// the joint stage of 64 balls (n = 384, lambda = 32), as docs/cmaes.md says.
+#[test]
+fn the_eigenbasis_is_refreshed_at_purecmas_gap() {
+    let interval = |n: usize, lambda: usize| {
+        let config = CmaesConfig {
+            population: Some(lambda),
+            ..CmaesConfig::default()
+        };
+        Cmaes::new(&vec![0.0; n], 1.0, config, 1).eigen_interval
+    };
+    assert!(interval(6, 12) < 1.0, "{}", interval(6, 12));
+    assert!(
+        (1.0..2.0).contains(&interval(10, 10)),
+        "{}",
+        interval(10, 10)
+    );
+    assert!(
+        (11.0..12.0).contains(&interval(384, 32)),
+        "{}",
+        interval(384, 32)
+    );
+}
