@@ -3,7 +3,7 @@
 //! stage ranks by ([`Outcome`]), and the searches for one body or one pair.
 
 use super::{Held, Outcome, Problem, Workspace};
-use crate::sim::contact::{self, Body, Motion};
+use crate::sim::contact::{self, BallStart, Body, Motion};
 use crate::sim::flight::FreeFlight;
 
 /// Contacts closer together in time than this (s) are counted as one event's contacts.
@@ -70,30 +70,51 @@ impl Problem {
         }
         let held_pairs = ws.pair_hits.len();
         ws.pair_counts.clear();
-        let mut key = n;
+        let flights_of = |k: usize| match held {
+            Some(h) if !h.varying[k] => &h.flights[..],
+            _ => &ws.flights[..],
+        };
+        ws.varying.clear();
+        ws.varying.extend((0..n).filter(|&k| varies(k)));
+        for &k in &ws.varying {
+            ws.balls[k] = BallStart::of(&self.body(k, &ws.flights));
+        }
+        let ball = |k: usize| match held {
+            Some(h) if !h.varying[k] => &h.balls[k],
+            _ => &ws.balls[k],
+        };
         for i in 0..n {
-            for j in (i + 1)..n {
-                key += 1;
-                if !scene.occluders[i].launched && !scene.occluders[j].launched
-                    || !varies(i) && !varies(j)
-                {
+            // The pairs of `i` with a varying body, in the order of their keys: a
+            // stage of one body searches 63 of a picture's 2,016 pairs of 64 balls.
+            let (all, later) = if varies(i) {
+                (i + 1..n, &[][..])
+            } else {
+                let from = ws.varying.partition_point(|&k| k <= i);
+                (0..0, &ws.varying[from..])
+            };
+            for j in all.chain(later.iter().copied()) {
+                if !scene.occluders[i].launched && !scene.occluders[j].launched {
                     continue;
                 }
+                let key = n + i * (n - 1) - i * i.saturating_sub(1) / 2 + (j - i - 1);
                 // Every pair searched here involves a varying body: it is searched up
                 // to the first such contact, which finds the first contact of all too.
                 let horizon = t.min(own + SIMULTANEOUS);
-                let flights_of = |k: usize| match held {
-                    Some(h) if !h.varying[k] => &h.flights[..],
-                    _ => &ws.flights[..],
+                let hit = match (ball(i), ball(j)) {
+                    (Some(a), Some(b)) => contact::ball_pair_contact_time(a, b, horizon).ok(),
+                    _ => None,
                 };
-                if let Some(tc) = self.pair_contact(i, flights_of(i), j, flights_of(j), horizon) {
+                let hit = hit.unwrap_or_else(|| {
+                    self.pair_contact(i, flights_of(i), j, flights_of(j), horizon)
+                });
+                if let Some(tc) = hit {
                     ws.pair_hits.push(tc);
                     ws.pair_counts.push(!ignored(i) && !ignored(j));
                     if !ignored(i) && !ignored(j) {
                         own = own.min(tc);
                     }
-                    if (tc, key - 1) < best {
-                        best = (tc, key - 1);
+                    if (tc, key) < best {
+                        best = (tc, key);
                         first = Some((i, Some(j)));
                     }
                 }
@@ -154,12 +175,7 @@ impl Problem {
         if !scene.occluders[i].launched {
             return (None, None);
         }
-        let body = Body {
-            motion: self.motion(i, flights),
-            shape: &self.shapes[i],
-            radius: scene.occluders[i].bounding_radius,
-        };
-        let c = contact::table_contact(&body, table, ts, self.plan.horizon);
+        let c = contact::table_contact(&self.body(i, flights), table, ts, self.plan.horizon);
         (c.filter(|c| c.landed).map(|c| c.time), c.map(|c| c.time))
     }
 
@@ -173,17 +189,15 @@ impl Problem {
         fj: &[FreeFlight],
         horizon: f64,
     ) -> Option<f64> {
-        let occ = &self.scene.occluders;
-        let a = Body {
-            motion: self.motion(i, fi),
+        contact::pair_contact_time(&self.body(i, fi), &self.body(j, fj), horizon)
+    }
+
+    /// Occluder `i` (its flight in `flights`) as the contact searches see it.
+    pub(super) fn body<'a>(&'a self, i: usize, flights: &'a [FreeFlight]) -> Body<'a> {
+        Body {
+            motion: self.motion(i, flights),
             shape: &self.shapes[i],
-            radius: occ[i].bounding_radius,
-        };
-        let b = Body {
-            motion: self.motion(j, fj),
-            shape: &self.shapes[j],
-            radius: occ[j].bounding_radius,
-        };
-        contact::pair_contact_time(&a, &b, horizon)
+            radius: self.scene.occluders[i].bounding_radius,
+        }
     }
 }

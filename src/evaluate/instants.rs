@@ -428,7 +428,7 @@ impl Problem {
             }
         }
         ws.multi.energies = energies;
-        self.physics_terms(params, &outcome, &mut raw);
+        self.physics_terms(params, &outcome, &mut raw, None);
         // The image energy of the `worst` objective or of launch errors replaces the
         // weighted sum of the instants.
         let total = match image_total {
@@ -466,7 +466,8 @@ impl Problem {
         let target = &self.pictures[inst.picture];
         let mut r = [0.0; TERM_COUNT];
         energy::image_terms(target, &ws.mask, weights, &mut r);
-        self.hint_and_barrier(&self.scene.pictures[inst.picture].hints, target, ws, &mut r);
+        let hints = &self.scene.pictures[inst.picture].hints;
+        self.hint_and_barrier(hints, target, ws, &mut r, None);
         for t in IMAGE_AND_SCENE {
             raw[t as usize] += inst.weight * r[t as usize];
         }
@@ -637,28 +638,55 @@ impl Problem {
         (bad, depth)
     }
 
-    /// The hint and barrier terms of the poses in `ws.poses` for `hints` and `target`.
+    /// The hint and barrier terms of the poses in `ws.poses` for `hints` and `target`;
+    /// with `held` (the scene's own hints and target only), the held occluders' shares
+    /// as it keeps them.
     pub(super) fn hint_and_barrier(
         &self,
         hints: &[Hint],
         target: &energy::TargetData,
         ws: &Workspace,
         raw: &mut [f64; TERM_COUNT],
+        held: Option<&Held>,
     ) {
-        let cam = &self.scene.camera;
         let mut hint = 0.0;
-        for h in hints {
-            let (p, q) = ws.poses[h.occluder];
-            let world = p + q * h.point;
-            hint += h.weight * target.hint_distance(cam.project(world), h.pixel);
+        for (k, h) in hints.iter().enumerate() {
+            hint += match held {
+                Some(held) if !held.varying[h.occluder] => held.terms.hints[k],
+                _ => self.hint_term(h, target, ws.poses[h.occluder]),
+            };
         }
         raw[Term::Hint as usize] = hint;
         let mut barrier = 0.0;
-        for (i, o) in self.scene.occluders.iter().enumerate() {
-            let (p, q) = ws.poses[i];
-            barrier += target.barrier(cam.project(p + q * o.mass.local_com));
+        for (i, &pose) in ws.poses.iter().enumerate() {
+            barrier += match held {
+                Some(held) if !held.varying[i] => held.terms.barrier[i],
+                _ => self.barrier_term(target, i, pose),
+            };
         }
         raw[Term::Barrier as usize] = barrier;
+    }
+
+    /// Hint `h`'s share of the hint term, its occluder at `(p, q)`.
+    pub(super) fn hint_term(
+        &self,
+        h: &Hint,
+        target: &energy::TargetData,
+        (p, q): (DVec3, DQuat),
+    ) -> f64 {
+        let world = p + q * h.point;
+        h.weight * target.hint_distance(self.scene.camera.project(world), h.pixel)
+    }
+
+    /// Occluder `i`'s share of the barrier term at `(p, q)`.
+    pub(super) fn barrier_term(
+        &self,
+        target: &energy::TargetData,
+        i: usize,
+        (p, q): (DVec3, DQuat),
+    ) -> f64 {
+        let local_com = self.scene.occluders[i].mass.local_com;
+        target.barrier(self.scene.camera.project(p + q * local_com))
     }
 
     /// The IoU of the nominal launch `params` at every frame the reports show: every

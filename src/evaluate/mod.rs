@@ -35,6 +35,7 @@ use crate::geometry::shape::Shape;
 use crate::scene::{Launch, Scene};
 use crate::shadow::mask::Mask;
 use crate::shadow::raster::{MeshSilhouette, RasterScratch, ShadowCamera};
+use crate::sim::contact::BallStart;
 use crate::sim::flight::{FlightConfig, FreeFlight};
 
 mod contacts;
@@ -105,6 +106,22 @@ pub struct Problem {
     pub flight: FlightConfig,
 }
 
+/// What [`Held`] keeps of the terms that add up a share per occluder or hint.
+struct HeldTerms {
+    reg: Vec<f64>,
+    barrier: Vec<f64>,
+    hints: Vec<f64>,
+}
+
+/// Occluder `i`'s share of the regularization: its launch speed and spin.
+fn reg_term(params: &[f64], i: usize) -> f64 {
+    let Launch {
+        velocity: v,
+        angular_velocity: w,
+    } = Launch::get(params, i);
+    REG_ALPHA * v.length() + (1.0 - REG_ALPHA) * w.length()
+}
+
 /// Per-worker reusable buffers.
 pub struct Workspace {
     flights: Vec<FreeFlight>,
@@ -122,6 +139,11 @@ pub struct Workspace {
     /// Whether each pair contact searched in the last sample (after the held ones in
     /// `pair_hits`) counts in [`Outcome::own_contact`].
     pair_counts: Vec<bool>,
+    /// Each varying body's launch if it is a ball flying without drag, for the pair
+    /// searches ([`Held`] has the held ones').
+    balls: Vec<Option<BallStart>>,
+    /// The varying bodies of the last sample, in order.
+    varying: Vec<usize>,
     /// Buffers of the multi-evaluation.
     multi: instants::Scratch,
 }
@@ -200,6 +222,11 @@ pub struct Held {
     varying: Vec<bool>,
     /// Flights of the held launched occluders (the varying ones' are unused).
     flights: Vec<FreeFlight>,
+    /// The held balls' launches, for the pair searches ([`BallStart`]).
+    balls: Vec<Option<BallStart>>,
+    /// The held occluders' shares of the regularization and barrier terms, and the held
+    /// hints' of the hint term, as every sample would compute them again.
+    terms: HeldTerms,
     poses: Vec<(DVec3, DQuat)>,
     landing: Vec<Option<f64>>,
     table_hit: Vec<Option<f64>>,
@@ -252,6 +279,12 @@ impl Problem {
             base: base.to_vec(),
             varying,
             flights: Vec::new(),
+            balls: vec![None; n],
+            terms: HeldTerms {
+                reg: vec![0.0; n],
+                barrier: vec![0.0; n],
+                hints: vec![0.0; scene.hints.len()],
+            },
             poses: vec![(DVec3::ZERO, DQuat::IDENTITY); n],
             landing: vec![None; n],
             table_hit: vec![None; n],
@@ -269,6 +302,7 @@ impl Problem {
         let mut key = n;
         for i in 0..n {
             if !held.varying[i] {
+                held.balls[i] = BallStart::of(&self.body(i, &ws.flights));
                 (held.landing[i], held.table_hit[i]) = self.table_contact(i, &ws.flights);
                 ws.landing[i] = held.landing[i];
                 held.poses[i] = self.state_at(&ws, i, scene.t).0;
@@ -285,6 +319,15 @@ impl Problem {
                 {
                     held.pair_hits.push((tc, key - 1, i, j));
                 }
+            }
+        }
+        for i in (0..n).filter(|&i| !held.varying[i]) {
+            held.terms.reg[i] = reg_term(base, i);
+            held.terms.barrier[i] = self.barrier_term(&self.target, i, held.poses[i]);
+        }
+        for (k, h) in scene.hints.iter().enumerate() {
+            if !held.varying[h.occluder] {
+                held.terms.hints[k] = self.hint_term(h, &self.target, held.poses[h.occluder]);
             }
         }
         self.shadow_with(None, Some(&kept), &mut ws);
@@ -374,6 +417,8 @@ impl Problem {
             table_hit: vec![None; n],
             pair_hits: Vec::with_capacity(n * n.saturating_sub(1) / 2),
             pair_counts: Vec::with_capacity(n * n.saturating_sub(1) / 2),
+            balls: vec![None; n],
+            varying: Vec::with_capacity(n),
             multi: instants::Scratch::new(n, &self.plan),
         }
     }
@@ -437,7 +482,7 @@ impl Problem {
         self.shadow_with(held.map(|h| &h.mask), held.map(|h| &h.varying[..]), ws);
         let mut raw = [0.0; TERM_COUNT];
         let counts = energy::image_terms(&self.target, &ws.mask, weights, &mut raw);
-        self.physics_and_scene_terms(params, &outcome, ws, &mut raw);
+        self.physics_and_scene_terms(params, &outcome, ws, &mut raw, held);
         let total = energy::weighted_total(&raw, weights);
         let iou = energy::iou_of(&self.target, &ws.mask, counts);
         Evaluation {
@@ -521,25 +566,31 @@ impl Problem {
         outcome: &Outcome,
         ws: &Workspace,
         raw: &mut [f64; TERM_COUNT],
+        held: Option<&Held>,
     ) {
-        self.physics_terms(params, outcome, raw);
-        self.hint_and_barrier(&self.scene.hints, &self.target, ws, raw);
+        self.physics_terms(params, outcome, raw, held);
+        self.hint_and_barrier(&self.scene.hints, &self.target, ws, raw, held);
     }
 
     /// The contact term (contact time before the horizon times the count) and the
-    /// regularization.
-    fn physics_terms(&self, params: &[f64], outcome: &Outcome, raw: &mut [f64; TERM_COUNT]) {
+    /// regularization (the held occluders' shares from `held`).
+    fn physics_terms(
+        &self,
+        params: &[f64],
+        outcome: &Outcome,
+        raw: &mut [f64; TERM_COUNT],
+        held: Option<&Held>,
+    ) {
         let scene = &self.scene;
         raw[Term::Contact as usize] =
             (self.plan.horizon - outcome.t_sim) * outcome.n_contacts as f64;
         let mut reg = 0.0;
         for (i, o) in scene.occluders.iter().enumerate() {
             if o.launched {
-                let Launch {
-                    velocity: v,
-                    angular_velocity: w,
-                } = Launch::get(params, i);
-                reg += REG_ALPHA * v.length() + (1.0 - REG_ALPHA) * w.length();
+                reg += match held {
+                    Some(h) if !h.varying[i] => h.terms.reg[i],
+                    _ => reg_term(params, i),
+                };
             }
         }
         raw[Term::Reg as usize] = reg;
@@ -602,7 +653,7 @@ impl Problem {
         }
         let outcome = self.fly(params, ws);
         let mut raw = [0.0; TERM_COUNT];
-        let us = time(&mut || self.physics_and_scene_terms(params, &outcome, ws, &mut raw));
+        let us = time(&mut || self.physics_and_scene_terms(params, &outcome, ws, &mut raw, None));
         out.push((PROFILE_PHASES[9].into(), us));
         let us = time(&mut || {
             std::hint::black_box(self.evaluate(params, &all, ws));

@@ -212,7 +212,7 @@ fn instant_energies(p: &Problem, params: &[f64], w: &Weights) -> Vec<f64> {
             let mut r = [0.0; TERM_COUNT];
             energy::image_terms(&p.pictures[inst.picture], &ws.mask, w, &mut r);
             let pic = &p.scene.pictures[inst.picture];
-            p.hint_and_barrier(&pic.hints, &p.pictures[inst.picture], &ws, &mut r);
+            p.hint_and_barrier(&pic.hints, &p.pictures[inst.picture], &ws, &mut r, None);
             energy::weighted_total(&r, w)
         })
         .collect()

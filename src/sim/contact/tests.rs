@@ -23,6 +23,16 @@ fn flight(shape: &Shape, pos: DVec3, v: DVec3, w: DVec3, g: DVec3, t_max: f64) -
     f
 }
 
+/// A stream of numbers uniform in `[0, 1)` (a linear congruential generator).
+fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 #[test]
 fn head_on_balls_collide_at_the_analytic_time() {
     let g = DVec3::new(0.0, 0.0, -9.81);
@@ -310,13 +320,7 @@ fn ball_table_closed_form_matches_conservative_advancement() {
         half_extents: DVec3::new(1.5, 1.0, 0.5),
     };
     let ts = table_shape(&table);
-    let mut seed = 99u64;
-    let mut rnd = || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rnd = uniform(99);
     let mut landed = 0;
     for _ in 0..300 {
         let r = 0.05 + 0.3 * rnd();
@@ -351,6 +355,68 @@ fn ball_table_closed_form_matches_conservative_advancement() {
         }
     }
     assert!(landed > 100, "only {landed} landings exercised");
+}
+
+#[test]
+fn two_balls_meet_in_closed_form_when_conservative_advancement_finds_them() {
+    // Pairs of balls thrown about one another, as exact balls (the closed form of
+    // `ball_pair_contact_time`) and as parry balls (conservative advancement): they must
+    // meet at the same time, or both not at all; some start touching.
+    let g = DVec3::new(0.0, 0.0, -9.81);
+    let mut rnd = uniform(7);
+    let (mut met, mut touching) = (0, 0);
+    for _ in 0..300 {
+        let (ra, rb) = (0.02 + 0.1 * rnd(), 0.02 + 0.1 * rnd());
+        let (sa, sb) = (Shape::Sphere { radius: ra }, Shape::Sphere { radius: rb });
+        let mut cube = || DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5);
+        let (pa, pb, va) = (cube() + DVec3::Z, cube() + DVec3::Z, cube() * 6.0);
+        // Mostly towards a, often enough to meet it.
+        let vb = va + (pa - pb) * 2.0 + cube();
+        let pb = match pb.x < -0.4 {
+            true => pa + DVec3::X * (ra + rb),
+            false => pb,
+        };
+        let (fa, fb) = (
+            flight(&sa, pa, va, DVec3::ZERO, g, 2.0),
+            flight(&sb, pb, vb, DVec3::ZERO, g, 2.0),
+        );
+        let (ea, eb) = (ContactShape::new(&sa), ContactShape::new(&sb));
+        // Its sphere cover the ball itself.
+        let parry = |r: f64| {
+            ContactShape::Parry(
+                Arc::new(Ball::new(r as f32)),
+                Arc::new([(DVec3::ZERO, r)]),
+                None,
+            )
+        };
+        let (qa, qb) = (parry(ra), parry(rb));
+        let body = |f, shape, radius| Body {
+            motion: Motion::Flying(f),
+            shape,
+            radius,
+        };
+        let (a, b) = (body(&fa, &ea, ra), body(&fb, &eb, rb));
+        let closed = (BallStart::of(&a).unwrap(), BallStart::of(&b).unwrap());
+        match ball_pair_contact_time(&closed.0, &closed.1, 2.0) {
+            Err(_) => touching += 1,
+            Ok(x) => {
+                let y = pair_contact_time(&body(&fa, &qa, ra), &body(&fb, &qb, rb), 2.0);
+                assert_eq!(pair_contact_time(&a, &b, 2.0), x);
+                match (x, y) {
+                    (Some(x), Some(y)) => {
+                        met += 1;
+                        assert!((x - y).abs() < 1e-4, "closed form {x} vs advancement {y}");
+                    }
+                    (None, None) => {}
+                    other => panic!("disagree: {other:?} for {pa} {va}, {pb} {vb}"),
+                }
+            }
+        }
+    }
+    assert!(
+        met > 30 && touching > 10,
+        "only {met} meetings and {touching} touching"
+    );
 }
 
 #[test]

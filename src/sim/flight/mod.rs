@@ -418,9 +418,13 @@ impl FreeFlight {
         }
     }
 
-    /// Body origin at time `t` (world): `com(t) - R(t) local_com`.
+    /// Body origin at time `t` (world): `com(t) - R(t) local_com`; the centre of mass
+    /// itself, without the orientation, where the two coincide (a ball).
     #[inline]
     pub fn origin(&self, t: f64) -> DVec3 {
+        if self.local_com == DVec3::ZERO {
+            return self.com(t);
+        }
         self.com(t) - self.orientation(t) * self.local_com
     }
 
