@@ -53,6 +53,10 @@ pub const TABLE_LEAVE: f64 = 1e-4;
 /// within micrometres for a long time) is reported as a contact, which is the safe side.
 const MAX_STEPS: usize = 100_000;
 
+/// Bounding spheres this far apart (m) hold shapes that certainly do not touch: a
+/// thousand times the contact distance, far beyond any rounding or GJK's tolerance.
+const APART: f64 = 1e-3;
+
 /// Below this lower bound of the distance (m) between two sphere covers, conservative
 /// advancement asks parry for the exact distance; above it, the cheap bound drives it.
 const COVER_SWITCH: f64 = 1e-3;
@@ -170,11 +174,19 @@ pub fn pair_contact_time(a: &Body, b: &Body, horizon: f64) -> Option<f64> {
             Err(d0) => touching_pair_contact_time(a, b, d0, horizon),
         };
     }
-    let (pa, qa) = a.motion.pose(0.0);
-    let (pb, qb) = b.motion.pose(0.0);
-    let d0 = signed_distance(a.shape, pa, qa, b.shape, pb, qb);
-    if d0 <= CONTACT_DISTANCE {
-        return touching_pair_contact_time(a, b, d0, horizon);
+    // Whether they touch at launch. Bounding spheres (about the centres of mass) a
+    // millimetre apart hold shapes that do not, which no distance query then asks; a
+    // ball can stand in for a degenerate mesh about its origin instead.
+    let spheres_apart = !matches!(a.shape, ContactShape::Ball(_))
+        && !matches!(b.shape, ContactShape::Ball(_))
+        && a.motion.com(0.0).distance(b.motion.com(0.0)) - a.radius - b.radius > APART;
+    if !spheres_apart {
+        let (pa, qa) = a.motion.pose(0.0);
+        let (pb, qb) = b.motion.pose(0.0);
+        let d0 = signed_distance(a.shape, pa, qa, b.shape, pb, qb);
+        if d0 <= CONTACT_DISTANCE {
+            return touching_pair_contact_time(a, b, d0, horizon);
+        }
     }
     let both_fly = a.motion.is_flying() && b.motion.is_flying();
     let reach = a.radius + b.radius;
