@@ -40,7 +40,7 @@ const TABLES: [&str; 5] = [
 /// The planted draws the page shows, the last in the ledger.
 const LAST_DRAWS: usize = 4;
 /// The runs of the `bsa new` suite the page shows, the last in the ledger.
-const LAST_RUNS: usize = 8;
+const LAST_RUNS: usize = 6;
 
 /// One row of a ledger file.
 #[derive(Clone, Debug)]
