@@ -110,11 +110,21 @@ pub fn cover_gap(
         (ContactShape::Parry(_, ca, _), ContactShape::Parry(_, cb, _)) => (ca, cb),
         _ => return None,
     };
+    // a's spheres placed once (a cover has at most COVER_SLABS), not once per b's.
+    let mut placed = [(DVec3::ZERO, 0.0); COVER_SLABS];
+    let place = |&(c, r): &(DVec3, f64)| (pa + qa * c, r);
+    let wa: &[(DVec3, f64)] = if ca.len() <= COVER_SLABS {
+        for (w, c) in placed.iter_mut().zip(ca.iter()) {
+            *w = place(c);
+        }
+        &placed[..ca.len()]
+    } else {
+        &ca.iter().map(place).collect::<Vec<_>>()
+    };
     let mut best = f64::INFINITY;
     for &(c1, r1) in cb.iter() {
         let w1 = pb + qb * c1;
-        for &(c0, r0) in ca.iter() {
-            let w0 = pa + qa * c0;
+        for &(w0, r0) in wa {
             best = best.min(w0.distance(w1) - r0 - r1);
         }
     }
