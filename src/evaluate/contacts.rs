@@ -134,29 +134,7 @@ impl Problem {
         } else {
             0.0
         };
-        let best = best.0;
-        if best >= t {
-            return Outcome {
-                t_sim: t,
-                n_contacts: 0,
-                first_contact: None,
-                own_contact,
-            };
-        }
-        let cut = best + SIMULTANEOUS;
-        let count = ws
-            .table_hit
-            .iter()
-            .flatten()
-            .filter(|&&tl| tl <= cut)
-            .count()
-            + ws.pair_hits.iter().filter(|&&tc| tc <= cut).count();
-        Outcome {
-            t_sim: best,
-            n_contacts: (count as u32).max(1),
-            first_contact: first,
-            own_contact,
-        }
+        outcome(ws, t, (best.0, first), own_contact)
     }
 
     /// Occluder `i`'s first table contact over the flight to `t`: (its landing, its first
@@ -199,5 +177,38 @@ impl Problem {
             shape: &self.shapes[i],
             radius: self.scene.occluders[i].bounding_radius,
         }
+    }
+}
+
+/// The outcome of a sample flown to `t` whose first contact is at `best` (infinite when
+/// there is none), between the bodies `first`: every contact within [`SIMULTANEOUS`] of
+/// it counts.
+fn outcome(
+    ws: &Workspace,
+    t: f64,
+    (best, first): (f64, Option<(usize, Option<usize>)>),
+    own_contact: f64,
+) -> Outcome {
+    if best >= t {
+        return Outcome {
+            t_sim: t,
+            n_contacts: 0,
+            first_contact: None,
+            own_contact,
+        };
+    }
+    let cut = best + SIMULTANEOUS;
+    let count = ws
+        .table_hit
+        .iter()
+        .flatten()
+        .filter(|&&tl| tl <= cut)
+        .count()
+        + ws.pair_hits.iter().filter(|&&tc| tc <= cut).count();
+    Outcome {
+        t_sim: best,
+        n_contacts: (count as u32).max(1),
+        first_contact: first,
+        own_contact,
     }
 }

@@ -174,19 +174,8 @@ pub fn pair_contact_time(a: &Body, b: &Body, horizon: f64) -> Option<f64> {
             Err(d0) => touching_pair_contact_time(a, b, d0, horizon),
         };
     }
-    // Whether they touch at launch. Bounding spheres (about the centres of mass) a
-    // millimetre apart hold shapes that do not, which no distance query then asks; a
-    // ball can stand in for a degenerate mesh about its origin instead.
-    let spheres_apart = !matches!(a.shape, ContactShape::Ball(_))
-        && !matches!(b.shape, ContactShape::Ball(_))
-        && a.motion.com(0.0).distance(b.motion.com(0.0)) - a.radius - b.radius > APART;
-    if !spheres_apart {
-        let (pa, qa) = a.motion.pose(0.0);
-        let (pb, qb) = b.motion.pose(0.0);
-        let d0 = signed_distance(a.shape, pa, qa, b.shape, pb, qb);
-        if d0 <= CONTACT_DISTANCE {
-            return touching_pair_contact_time(a, b, d0, horizon);
-        }
+    if let Some(d0) = launch_distance(a, b).filter(|&d| d <= CONTACT_DISTANCE) {
+        return touching_pair_contact_time(a, b, d0, horizon);
     }
     let both_fly = a.motion.is_flying() && b.motion.is_flying();
     let reach = a.radius + b.radius;
@@ -292,6 +281,22 @@ pub fn pair_contact_time(a: &Body, b: &Body, horizon: f64) -> Option<f64> {
         }
     }
     Some(s)
+}
+
+/// The distance of two bodies at launch, where they may touch then: not where their
+/// bounding spheres (about the centres of mass) are [`APART`], which hold shapes that
+/// cannot, and which no distance query then asks (a ball, which can stand in for a
+/// degenerate mesh about its origin instead, is always asked).
+fn launch_distance(a: &Body, b: &Body) -> Option<f64> {
+    let balls =
+        matches!(a.shape, ContactShape::Ball(_)) || matches!(b.shape, ContactShape::Ball(_));
+    let gap = a.motion.com(0.0).distance(b.motion.com(0.0)) - a.radius - b.radius;
+    if !balls && gap > APART {
+        return None;
+    }
+    let (pa, qa) = a.motion.pose(0.0);
+    let (pb, qb) = b.motion.pose(0.0);
+    Some(signed_distance(a.shape, pa, qa, b.shape, pb, qb))
 }
 
 /// A ball flying without drag, as [`ball_pair_contact_time`] takes it: what the search
