@@ -128,7 +128,13 @@ pub struct Cover<'a> {
     /// The pose family of every placement.
     families: Vec<Family>,
     pub placements: Vec<Placement>,
+    /// The whole picture's distance transform and ridge, once ([`Cover::best_disc`]
+    /// takes them for every ball).
+    whole: std::cell::OnceCell<(Vec<f32>, Ridge)>,
 }
+
+/// Ridge pixels of a picture ([`Picture::ridge`]).
+type Ridge = Vec<(usize, usize)>;
 
 /// One candidate being scored.
 #[derive(Clone, Copy, Debug)]
@@ -178,6 +184,7 @@ impl<'a> Cover<'a> {
             heights: Vec::new(),
             families: Vec::new(),
             placements: Vec::new(),
+            whole: std::cell::OnceCell::new(),
         }
     }
 
@@ -348,13 +355,17 @@ impl<'a> Cover<'a> {
     /// Returns the placement and the sphere's radius (m, whole millimetres).
     pub fn best_disc(&self, object: usize) -> Option<(Placement, f64)> {
         let w = self.picture.width;
-        let full = self.picture.distance();
+        let (full, ridge) = self.whole.get_or_init(|| {
+            let full = self.picture.distance();
+            let ridge = self.picture.ridge(&full);
+            (full, ridge)
+        });
         let open = self.open_picture();
-        let mut cands = self.picture.ridge(&full);
+        let mut cands = ridge.clone();
         cands.extend(open.ridge(&open.distance()));
         thin(
             &mut cands,
-            &full,
+            full,
             w,
             (w.max(self.picture.height) / 120).max(2),
         );
