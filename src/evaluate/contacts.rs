@@ -96,17 +96,16 @@ impl Problem {
                 if !scene.occluders[i].launched && !scene.occluders[j].launched {
                     continue;
                 }
-                let key = n + i * (n - 1) - i * i.saturating_sub(1) / 2 + (j - i - 1);
+                let key = pair_key(n, i, j);
                 // Every pair searched here involves a varying body: it is searched up
                 // to the first such contact, which finds the first contact of all too.
                 let horizon = t.min(own + SIMULTANEOUS);
+                // Two balls touching at launch (`Err`) take the whole search.
                 let hit = match (ball(i), ball(j)) {
                     (Some(a), Some(b)) => contact::ball_pair_contact_time(a, b, horizon).ok(),
                     _ => None,
-                };
-                let hit = hit.unwrap_or_else(|| {
-                    self.pair_contact(i, flights_of(i), j, flights_of(j), horizon)
-                });
+                }
+                .unwrap_or_else(|| self.pair_contact(i, flights_of(i), j, flights_of(j), horizon));
                 if let Some(tc) = hit {
                     ws.pair_hits.push(tc);
                     ws.pair_counts.push(!ignored(i) && !ignored(j));
@@ -178,6 +177,12 @@ impl Problem {
             radius: self.scene.occluders[i].bounding_radius,
         }
     }
+}
+
+/// The order key of the pair `(i, j)`, `i < j`, of `n` occluders: after the `n` table
+/// contacts, the pairs in `(i, j)` order.
+pub(super) fn pair_key(n: usize, i: usize, j: usize) -> usize {
+    n + i * (n - 1) - i * i.saturating_sub(1) / 2 + (j - i - 1)
 }
 
 /// The outcome of a sample flown to `t` whose first contact is at `best` (infinite when

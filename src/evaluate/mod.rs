@@ -299,7 +299,6 @@ impl Problem {
         }
         let kept: Vec<bool> = held.varying.iter().map(|v| !v).collect();
         self.launch(Some(&kept), base, &mut ws);
-        let mut key = n;
         for i in 0..n {
             if !held.varying[i] {
                 held.balls[i] = BallStart::of(&self.body(i, &ws.flights));
@@ -309,7 +308,6 @@ impl Problem {
                 ws.poses[i] = held.poses[i];
             }
             for j in (i + 1)..n {
-                key += 1;
                 let both_fixed = !scene.occluders[i].launched && !scene.occluders[j].launched;
                 if held.varying[i] || held.varying[j] || both_fixed {
                     continue;
@@ -317,7 +315,7 @@ impl Problem {
                 if let Some(tc) =
                     self.pair_contact(i, &ws.flights, j, &ws.flights, self.plan.horizon)
                 {
-                    held.pair_hits.push((tc, key - 1, i, j));
+                    held.pair_hits.push((tc, contacts::pair_key(n, i, j), i, j));
                 }
             }
         }

@@ -347,7 +347,7 @@ pub fn ball_pair_contact_time(
     }
     let reach = a.radius + b.radius;
     let overlap = linear_overlap_interval(b.com - a.com, b.velocity - a.velocity, reach, horizon);
-    Ok(overlap.map(|(s_in, _)| s_in).filter(|&s| s <= horizon))
+    Ok(overlap.map(|(s_in, _)| s_in))
 }
 
 /// The times in `[0, horizon]` at which `|d0 + dv s| <= reach`: an interval
