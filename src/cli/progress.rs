@@ -146,12 +146,18 @@ impl Observer for SolveProgress {
         );
     }
 
-    fn attempt_stage_finished(&mut self, s: &Solution) {
+    fn attempt_stage_finished(&mut self, s: &Solution, rows: &[SampleRecord]) {
         if let Some(bar) = self.bar.take() {
             bar.finish_and_clear();
         }
         if let Some(line) = stage_line(s) {
             println!("{}{line}", self.attempt_prefix());
+        }
+        // The attempt's rows are saved as its stages end (not all at the end of the
+        // solve), though its solution is not.
+        if !rows.is_empty() {
+            self.writer.send(Job::Rows(rows.to_vec()));
+            self.encoded += rows.len();
         }
     }
 
@@ -188,7 +194,7 @@ impl Observer for SolveProgress {
         }
     }
 
-    fn stage_finished(&mut self, s: &Solution, records: &[SampleRecord]) {
+    fn stage_finished(&mut self, s: &Solution, rows: &[SampleRecord]) {
         if let Some(bar) = self.bar.take() {
             bar.finish_and_clear();
         }
@@ -198,12 +204,11 @@ impl Observer for SolveProgress {
         if let Some(line) = stage_line(s) {
             println!("{line}");
         }
-        // `records` is every record of this run so far: only the new ones are handed over.
         self.writer.send(Job::Stage {
-            rows: records[self.encoded..].to_vec(),
+            rows: rows.to_vec(),
             solution: Box::new(s.clone()),
         });
-        self.encoded = records.len();
+        self.encoded += rows.len();
     }
 }
 

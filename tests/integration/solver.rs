@@ -60,26 +60,29 @@ fn same_seed_gives_bit_identical_solution_with_1_and_2_threads() {
 }
 
 /// Counts what an observer is told: stages started and finished, in the first attempt
-/// and in later ones, and the attempts started.
+/// and in later ones, the attempts started, and the rows of the finished stages.
 #[derive(Default, Debug, PartialEq)]
 struct Told {
     started: usize,
     finished: usize,
     later_finished: usize,
     attempts: Vec<(usize, u64)>,
+    rows: Vec<SampleRecord>,
 }
 impl Observer for Told {
     fn stage_started(&mut self, _index: usize, _stage: &bsa::scene::Stage) {
         self.started += 1;
     }
-    fn stage_finished(&mut self, _s: &Solution, _r: &[SampleRecord]) {
+    fn stage_finished(&mut self, _s: &Solution, r: &[SampleRecord]) {
         self.finished += 1;
+        self.rows.extend_from_slice(r);
     }
     fn attempt_started(&mut self, attempt: usize, _attempts: usize, _kept: &Solution, seed: u64) {
         self.attempts.push((attempt, seed));
     }
-    fn attempt_stage_finished(&mut self, _s: &Solution) {
+    fn attempt_stage_finished(&mut self, _s: &Solution, r: &[SampleRecord]) {
         self.later_finished += 1;
+        self.rows.extend_from_slice(r);
     }
 }
 
@@ -119,6 +122,8 @@ fn attempts_run_ahead_give_the_bits_and_progress_of_attempts_one_after_another()
     assert_eq!(seen(&a), seen(&b));
     assert_eq!(a.samples, b.samples);
     assert_eq!(told_a, told_b);
+    // Every record was told once, in order, with the stage that drew it.
+    assert_eq!(told_b.rows, rb);
     let stages = p.scene.stages.len();
     assert_eq!(told_b.started, 3 * stages);
     assert_eq!(
@@ -504,6 +509,22 @@ fn run_moves_for(
     rank: &dyn Fn(&bsa::evaluate::Evaluation) -> f64,
     purpose: Purpose,
 ) -> Moved {
+    run_moves_on(p, (vary, params), rank, purpose, 2, &mut |_| {})
+}
+
+/// [`run_moves_for`] on a pool of `threads`, every sample shown to `record`.
+fn run_moves_on(
+    p: &Problem,
+    (vary, params): (&[usize], &mut [f64]),
+    rank: &dyn Fn(&bsa::evaluate::Evaluation) -> f64,
+    purpose: Purpose,
+    threads: usize,
+    record: &mut dyn FnMut(&bsa::evaluate::Evaluation),
+) -> Moved {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
     let w = p.scene.stages.last().unwrap().weights;
     let mut ws = p.workspace();
     let mut best = p.evaluate(params, &w, &mut ws);
@@ -522,10 +543,41 @@ fn run_moves_for(
             settled: true,
             purpose,
         },
+        &pool,
         &mut ws,
-        &mut |_| {},
+        record,
     );
     (before, best, report)
+}
+
+/// The moves run their parts beside each other on the pool they are given: on one
+/// thread and on two they take the same moves and draw the same samples in the same
+/// order, bit for bit (the fixture's trades and polish seat, fit and evolve blocks).
+#[test]
+fn moves_on_two_threads_draw_the_samples_of_one_bit_for_bit() {
+    let dir = crate::util::root().join("tests/fixtures/cycle-of-sizes");
+    let p = Problem::new(bsa::scene::load(&dir).unwrap());
+    let stuck = launch_file(&p, &dir.join("stuck.json"));
+    let vary: Vec<usize> = (0..p.scene.occluders.len()).collect();
+    for purpose in [Purpose::Trade, Purpose::Polish] {
+        let run = |threads| {
+            let mut params = stuck.clone();
+            let mut totals = Vec::new();
+            let (_, best, report) = run_moves_on(
+                &p,
+                (&vary, &mut params),
+                &contact_free_first,
+                purpose,
+                threads,
+                &mut |e| totals.push(e.total.to_bits()),
+            );
+            let bits: Vec<u64> = params.iter().map(|x| x.to_bits()).collect();
+            (bits, best.total.to_bits(), report, totals)
+        };
+        let (one, two) = (run(1), run(2));
+        assert!(one.3.len() > 100, "{purpose:?}: {} samples", one.3.len());
+        assert_eq!(one, two, "{purpose:?}");
+    }
 }
 
 #[test]

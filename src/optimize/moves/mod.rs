@@ -197,18 +197,48 @@ const TRADE_SLACK: i64 = 4;
 /// Moves of a pass polished by [`Search::polish`]: those whose pictures rank first.
 const POLISHED: usize = 4;
 
-/// The evaluations of one call of [`improve`]: counts them, shows each to the caller's
-/// record, and keeps the promising launch (see [`MoveReport::promising`]).
+/// The evaluations of one call of [`improve`], or of one of its parallel parts: counts
+/// them, keeps them in order for the caller's record, and keeps the promising launch
+/// (see [`MoveReport::promising`]).
 struct Search<'a> {
     problem: &'a Problem,
     held: &'a Held,
     weights: &'a Weights,
-    record: &'a mut dyn FnMut(&Evaluation),
+    records: Vec<Evaluation>,
     samples: usize,
     promising: Option<(f64, Vec<f64>)>,
 }
 
-impl Search<'_> {
+impl<'a> Search<'a> {
+    fn new(problem: &'a Problem, held: &'a Held, weights: &'a Weights) -> Self {
+        Search {
+            problem,
+            held,
+            weights,
+            records: Vec::new(),
+            samples: 0,
+            promising: None,
+        }
+    }
+
+    /// A search of its own for a part that runs beside the others ([`Scratch`]).
+    fn part(&self) -> Search<'a> {
+        Search::new(self.problem, self.held, self.weights)
+    }
+
+    /// Take in `part`'s evaluations as if they were made here, after those made so far:
+    /// its promising launch (its first of the least energy) replaces this one's only
+    /// where strictly lower, as each evaluation's does in [`Search::evaluate`].
+    fn absorb(&mut self, part: Search<'a>) {
+        self.samples += part.samples;
+        self.records.extend(part.records);
+        if let Some((energy, launch)) = part.promising {
+            if self.promising.as_ref().is_none_or(|p| energy < p.0) {
+                self.promising = Some((energy, launch));
+            }
+        }
+    }
+
     /// `offer` as a trade the caller may search further.
     fn trade(&self, offer: &Offer) -> Trade {
         Trade {
@@ -228,7 +258,7 @@ impl Search<'_> {
             .problem
             .evaluate_held(self.held, candidate, self.weights, ws);
         self.samples += 1;
-        (self.record)(&e);
+        self.records.push(e);
         if e.outcome.own_contact > 0.0
             && e.total < DIVERGED_ENERGY
             && self.promising.as_ref().is_none_or(|p| self.free(&e) < p.0)
@@ -322,6 +352,7 @@ pub fn improve(
     params: &mut [f64],
     best: &mut Evaluation,
     options: MoveOptions,
+    pool: &rayon::ThreadPool,
     ws: &mut Workspace,
     record: &mut dyn FnMut(&Evaluation),
 ) -> MoveReport {
@@ -336,16 +367,14 @@ pub fn improve(
     if movable.is_empty() || (options.purpose.trades() && trades.is_empty()) {
         return report;
     }
-    let mut search = Search {
-        problem,
-        held,
-        weights,
-        record,
-        samples: 0,
-        promising: None,
-    };
-    let mut candidate = params.to_vec();
-    let mut flight = FreeFlight::default();
+    let mut search = Search::new(problem, held, weights);
+    let mut scratch: Vec<Scratch> = (0..pool.current_num_threads())
+        .map(|_| Scratch {
+            ws: problem.workspace(),
+            candidate: params.to_vec(),
+            flight: FreeFlight::default(),
+        })
+        .collect();
     let mut exchanges: Vec<Exchange> = Vec::new();
     let mut trade_offers: Vec<Trade> = Vec::new();
     let exchanges_wanted = exchange_pairs(scene, &movable) <= MAX_EXCHANGE_PAIRS;
@@ -379,18 +408,22 @@ pub fn improve(
             exchanges_wanted,
             trades: &trades,
         };
-        // Every move of the round, evaluated; the best few are then polished.
-        let mut out = Offers::new(&mut search, ws, &mut candidate, &mut flight);
-        for m in MOVES {
-            m.offer(&round, &mut out);
+        // Every move of the round, evaluated, each beside the others; the best few are
+        // then polished.
+        let mut offers = Vec::new();
+        let mut mesh_trades = 0..0;
+        exchanges.clear();
+        let parts = beside(pool, &mut search, MOVES.to_vec(), &mut scratch, |m, out| {
+            m.offer(&round, out)
+        });
+        for part in parts {
+            if !part.mesh_trades.is_empty() {
+                let at = offers.len();
+                mesh_trades = at + part.mesh_trades.start..at + part.mesh_trades.end;
+            }
+            offers.extend(part.list);
+            exchanges.extend(part.exchanges);
         }
-        let Offers {
-            list: mut offers,
-            exchanges: offered,
-            mesh_trades,
-            ..
-        } = out;
-        exchanges = offered;
         trade_offers = offers[mesh_trades]
             .iter()
             .map(|o| search.trade(o))
@@ -398,8 +431,14 @@ pub fn improve(
         // Polish the moves that made the best pictures (a move that made a poor one
         // seldom becomes the best by a change of depth), then take the best-ranked.
         offers.sort_by(|a, b| search.free(&a.eval).total_cmp(&search.free(&b.eval)));
-        let mut scratch = Offers::new(&mut search, ws, &mut candidate, &mut flight);
-        polish_best(&mut offers, held, &vary, options, &mut scratch);
+        polish_best(
+            pool,
+            &mut offers,
+            (held, &vary),
+            options,
+            &mut search,
+            &mut scratch,
+        );
         match best_offer(&offers, rank, &current) {
             Some(offer) => {
                 let e = offer.eval;
@@ -412,6 +451,9 @@ pub fn improve(
             }
             None => break,
         }
+    }
+    for e in &search.records {
+        record(e);
     }
     // Leave the workspace holding the kept launch's flight and shadow.
     *best = problem.evaluate_held(held, params, weights, ws);
@@ -524,31 +566,30 @@ fn exchange_pairs(scene: &crate::scene::Scene, movable: &[usize]) -> usize {
 /// part's size, place and tilt at once. (Fitting those of all four best moves raised
 /// the hand-made "to fly" a little more at 1.1 to 1.35 times the time: the spins that
 /// reach fitted poses are faster, and every later flight of a faster tumbling block
-/// costs more.)
-fn polish_best(
+/// costs more.) Each offer is polished beside the others ([`beside`]).
+fn polish_best<'a>(
+    pool: &rayon::ThreadPool,
     offers: &mut [Offer],
-    held: &Held,
-    vary: &[bool],
+    (held, vary): (&Held, &[bool]),
     options: MoveOptions,
-    out: &mut Offers,
+    search: &mut Search<'a>,
+    scratch: &mut [Scratch],
 ) {
-    let problem = out.search.problem;
+    let problem = search.problem;
     let is_block = |i: usize| fits_pose(&problem.scene.occluders[i].shape);
-    let mut polished = 0;
-    for offer in offers.iter_mut() {
-        if polished == POLISHED {
-            break;
-        }
-        if !(options.settled || offer.bodies.len() > 1) {
-            continue;
-        }
+    let chosen: Vec<(usize, &mut Offer)> = offers
+        .iter_mut()
+        .filter(|o| options.settled || o.bodies.len() > 1)
+        .take(POLISHED)
+        .enumerate()
+        .collect();
+    beside(pool, search, chosen, scratch, |(rank, offer), out| {
         offer.eval = out
             .search
             .polish(&mut offer.launch, offer.eval, &offer.bodies, out.ws);
-        polished += 1;
-        let fit = polished == 1 || offer.bodies.len() > 1;
+        let fit = rank == 0 || offer.bodies.len() > 1;
         if !(fit && offer.bodies.iter().any(|&b| is_block(b))) {
-            continue;
+            return;
         }
         out.candidate.copy_from_slice(&offer.launch);
         out.search.evaluate(out.candidate, out.ws);
@@ -572,5 +613,78 @@ fn polish_best(
                 offer.launch.copy_from_slice(out.candidate);
             }
         }
-    }
+    });
+}
+
+/// What a thread works in on the parts of a round ([`beside`]): a workspace, a
+/// candidate launch and a flight.
+struct Scratch {
+    ws: Workspace,
+    candidate: Vec<f64>,
+    flight: FreeFlight,
+}
+
+/// What a part of a round offered ([`Offers`] without its scratch).
+struct Offered {
+    list: Vec<Offer>,
+    exchanges: Vec<Exchange>,
+    mesh_trades: Range<usize>,
+}
+
+/// Run `work` on each of `items` beside the others on `pool`, each with a search of its
+/// own, the pool's threads taking the next item as they come free, each on a scratch of
+/// its own (one per thread); then absorb the items' searches into `search` in the items'
+/// order and return what each offered, in that order. Each item sets up the workspace
+/// and candidate it reads (as when one scratch served them all, one after the other),
+/// so the offers, the samples and their order are those of the items run one after the
+/// other, whatever the threads.
+///
+/// Why: a round's moves and polish draw thousands of shadows of one body (a seat scans
+/// hundreds of poses, a thorough fit evolves one), and on one thread they left the
+/// second core idle for a third of a solve of blocks or chess pieces.
+fn beside<'a, T: Send>(
+    pool: &rayon::ThreadPool,
+    search: &mut Search<'a>,
+    items: Vec<T>,
+    scratch: &mut [Scratch],
+    work: impl Fn(T, &mut Offers<'_, 'a>) + Sync,
+) -> Vec<Offered> {
+    use rayon::prelude::*;
+    let queue = std::sync::Mutex::new(items.into_iter().enumerate());
+    let next = || queue.lock().unwrap_or_else(|e| e.into_inner()).next();
+    let parent = &*search;
+    let mut done: Vec<(usize, Search<'a>, Offered)> = pool.install(|| {
+        scratch
+            .par_iter_mut()
+            .flat_map_iter(|s| {
+                let mut mine = Vec::new();
+                while let Some((k, item)) = next() {
+                    let mut part = parent.part();
+                    let mut out =
+                        Offers::new(&mut part, &mut s.ws, &mut s.candidate, &mut s.flight);
+                    work(item, &mut out);
+                    let Offers {
+                        list,
+                        exchanges,
+                        mesh_trades,
+                        ..
+                    } = out;
+                    let offered = Offered {
+                        list,
+                        exchanges,
+                        mesh_trades,
+                    };
+                    mine.push((k, part, offered));
+                }
+                mine
+            })
+            .collect()
+    });
+    done.sort_by_key(|d| d.0);
+    done.into_iter()
+        .map(|(_, part, offered)| {
+            search.absorb(part);
+            offered
+        })
+        .collect()
 }

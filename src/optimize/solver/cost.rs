@@ -34,7 +34,7 @@ const REFINE_SAMPLES: f64 = 0.2;
 /// The share of their caps that the runs of a solve draw at least, about: the examples'
 /// runs drew 60 % of theirs (fly, tbc, THE THINKER), Mickey's fewer (its target energy).
 const EARLY: f64 = 0.6;
-/// The moves of every stage (on one thread), against the runs' time: up to 30 %.
+/// The moves of every stage, against the runs' time: up to 30 %.
 const MOVES_TIME: f64 = 0.3;
 /// Seconds of sample timing per stage at most.
 const TIMING_BUDGET: f64 = 0.005;
@@ -97,7 +97,9 @@ pub fn estimate(problem: &Problem, schedule: &Schedule, threads: usize) -> Cost 
     Cost {
         samples: samples.ceil() as usize,
         seconds: (EARLY * one, (1.0 + MOVES_TIME) * one * attempts),
-        bytes: (pools * threads.max(1) + 2) * workspace + samples as usize * record,
+        // Each pool's threads evaluate in a workspace each, and work on the moves in
+        // another each (`moves::improve`).
+        bytes: (2 * pools * threads.max(1) + 2) * workspace + samples as usize * record,
     }
 }
 

@@ -99,15 +99,17 @@ pub trait Observer {
     /// Stage `index` starts its restart number `restart` with `population` samples per
     /// iteration.
     fn restarted(&mut self, _index: usize, _restart: usize, _population: usize) {}
-    /// Called after each stage with the solution so far (save it: nothing is lost).
-    fn stage_finished(&mut self, _solution: &Solution, _records: &[SampleRecord]) {}
+    /// Called after each stage with the solution so far (save it: nothing is lost) and
+    /// the records the stage added (every sample since the attempt's last stage).
+    fn stage_finished(&mut self, _solution: &Solution, _rows: &[SampleRecord]) {}
     /// A later attempt `attempt` (counted from 0) of at most `attempts` starts from the
     /// start guess with `seed`, the solution kept so far being `kept`.
     fn attempt_started(&mut self, _attempt: usize, _attempts: usize, _kept: &Solution, _seed: u64) {
     }
     /// A stage of a later attempt ended, with that attempt's solution so far (not to be
-    /// saved: the solution kept is the one saved).
-    fn attempt_stage_finished(&mut self, _solution: &Solution) {}
+    /// saved: the solution kept is the one saved) and the records the stage added (the
+    /// solve's records hold them after those of the attempts before).
+    fn attempt_stage_finished(&mut self, _solution: &Solution, _rows: &[SampleRecord]) {}
 }
 
 /// An observer that ignores everything (tests, benchmarks).
@@ -286,8 +288,8 @@ impl Observer for LaterAttempt<'_> {
     fn restarted(&mut self, index: usize, restart: usize, population: usize) {
         self.0.restarted(index, restart, population);
     }
-    fn stage_finished(&mut self, solution: &Solution, _records: &[SampleRecord]) {
-        self.0.attempt_stage_finished(solution);
+    fn stage_finished(&mut self, solution: &Solution, rows: &[SampleRecord]) {
+        self.0.attempt_stage_finished(solution, rows);
     }
 }
 
@@ -388,6 +390,8 @@ fn attempt(
     let threads = pool.threads();
     let start = Instant::now();
     let mut records = Vec::new();
+    // The records already handed to the observer with a finished stage.
+    let mut reported = 0;
     let Begun {
         mut params,
         first_stage,
@@ -453,7 +457,8 @@ fn attempt(
         };
         let mut s = summarize(problem, &params, &reports, &run, None);
         s.passes = passes.clone();
-        observer.stage_finished(&s, &records);
+        observer.stage_finished(&s, &records[reported..]);
+        reported = records.len();
         if stopped {
             aborted = true;
             break;

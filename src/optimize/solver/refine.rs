@@ -155,7 +155,8 @@ pub(super) fn polish(
     record: &mut dyn FnMut(&Evaluation),
 ) -> (usize, usize, usize) {
     let contacts = problem.scene.contacts;
-    let (mut samples, seated) = polish_moves(problem, held, stage, params, best, ws, record);
+    let (mut samples, seated) =
+        polish_moves(problem, pool, held, stage, (params, best), ws, record);
     let mut moved = 0;
     for (g, &body) in stage.vary.iter().enumerate() {
         let run = Stage {
@@ -193,10 +194,10 @@ pub(super) fn polish(
 /// the runs it gained less: 0.9981 against 0.9997 on boxes 11204).
 fn polish_moves(
     problem: &Problem,
+    pool: &Pool,
     held: &Held,
     stage: &Stage,
-    params: &mut [f64],
-    best: &mut Evaluation,
+    (params, best): (&mut [f64], &mut Evaluation),
     ws: &mut Workspace,
     record: &mut dyn FnMut(&Evaluation),
 ) -> (usize, usize) {
@@ -216,6 +217,7 @@ fn polish_moves(
             settled: true,
             purpose: moves::Purpose::Polish,
         },
+        pool.rayon(),
         ws,
         record,
     );

@@ -51,6 +51,11 @@ impl Pool {
         Pool { pool, workspaces }
     }
 
+    /// The pool's threads, for work that is not a population (the moves' parts).
+    pub(super) fn rayon(&self) -> &rayon::ThreadPool {
+        &self.pool
+    }
+
     /// The worker threads.
     pub(super) fn threads(&self) -> usize {
         self.workspaces.len()

@@ -258,6 +258,7 @@ impl<'a> StageRun<'a> {
                 settled: self.restart > 0 || self.given.vary.len() > 1,
                 purpose,
             },
+            self.pool.rayon(),
             &mut self.ws,
             &mut |e: &Evaluation| records.push(sample_record(k, iteration, &weights, e)),
         );
