@@ -42,32 +42,33 @@ impl Move for Seat {
         } else {
             r.meshes.to_vec()
         };
-        for &i in &own {
-            if let Some((cost, pose)) = seats.own(i, out.ws) {
-                if cost < r.wrong {
-                    seat(r, &[(i, pose)], out);
-                }
+        let owned = seats::each(problem, &own, |&i, ws| seats.own(i, ws));
+        for (&i, found) in own.iter().zip(owned) {
+            if let Some((_, pose)) = found.filter(|f| f.0 < r.wrong) {
+                seat(r, &[(i, pose)], out);
             }
         }
         // ... and two of a kind each on the other's: every pair scanned, the best
         // refined.
-        let mut scanned: Vec<(i64, usize, usize)> = Vec::new();
-        for (a, &i) in r.meshes.iter().enumerate() {
-            for &j in &r.meshes[a + 1..] {
-                if !r.exchanges_wanted || !exchangeable(&problem.scene, i, j) {
-                    continue;
-                }
-                if let Some((cost, _)) = seats.pair(i, j, 0, out.ws) {
-                    scanned.push((cost, i, j));
-                }
-            }
-        }
+        let pairs: Vec<(usize, usize)> = r
+            .meshes
+            .iter()
+            .enumerate()
+            .flat_map(|(a, &i)| r.meshes[a + 1..].iter().map(move |&j| (i, j)))
+            .filter(|&(i, j)| r.exchanges_wanted && exchangeable(&problem.scene, i, j))
+            .collect();
+        let scans = seats::each(problem, &pairs, |&(i, j), ws| seats.pair(i, j, 0, ws));
+        let mut scanned: Vec<(i64, usize, usize)> = (pairs.iter().zip(scans))
+            .filter_map(|(&(i, j), found)| Some((found?.0, i, j)))
+            .collect();
         scanned.sort();
-        for &(_, i, j) in scanned.iter().take(SEAT_PAIRS) {
-            if let Some((cost, [pi, pj])) = seats.pair(i, j, SEAT_KEPT, out.ws) {
-                if cost < r.wrong {
-                    seat(r, &[(i, pi), (j, pj)], out);
-                }
+        scanned.truncate(SEAT_PAIRS);
+        let refined = seats::each(problem, &scanned, |&(_, i, j), ws| {
+            seats.pair(i, j, SEAT_KEPT, ws)
+        });
+        for (&(_, i, j), found) in scanned.iter().zip(refined) {
+            if let Some((_, [pi, pj])) = found.filter(|f| f.0 < r.wrong) {
+                seat(r, &[(i, pi), (j, pj)], out);
             }
         }
         // ... and a hidden block seated beside another on that one's part, cut in two:
@@ -91,13 +92,15 @@ impl Move for Seat {
                 (seats::TRADES, 1)
             };
             let first = out.list.len();
-            for cycle in seats.trade_scan(group, cap, out.ws) {
-                if let Some((cost, poses)) = seats.many(&cycle, SEAT_KEPT, out.ws) {
-                    if cost < slack * r.wrong {
-                        let seated: Vec<(usize, (DVec3, DQuat))> =
-                            cycle.iter().map(|c| c.0).zip(poses).collect();
-                        seat(r, &seated, out);
-                    }
+            let cycles = seats.trade_scan(group, cap, out.ws);
+            let found = seats::each(problem, &cycles, |cycle, ws| {
+                seats.many(cycle, SEAT_KEPT, ws)
+            });
+            for (cycle, found) in cycles.iter().zip(found) {
+                if let Some((_, poses)) = found.filter(|f| f.0 < slack * r.wrong) {
+                    let seated: Vec<(usize, (DVec3, DQuat))> =
+                        cycle.iter().map(|c| c.0).zip(poses).collect();
+                    seat(r, &seated, out);
                 }
             }
             if of_meshes {

@@ -21,6 +21,22 @@ pub(super) struct Seats<'a> {
     pub(super) sights: &'a [Option<Sight>],
 }
 
+/// `f` of each of `items`, beside each other on the pool the caller runs on, each thread
+/// with a workspace of its own; the results in the items' order. Every seat sets up the
+/// workspace it reads ([`Seats::others`]), so they are those of the items one after the
+/// other. A round's seats are its costliest moves: hundreds of poses drawn per seat.
+pub(super) fn each<T: Sync, R: Send>(
+    problem: &Problem,
+    items: &[T],
+    f: impl Fn(&T, &mut Workspace) -> R + Sync,
+) -> Vec<R> {
+    use rayon::prelude::*;
+    items
+        .par_iter()
+        .map_init(|| problem.workspace(), |ws, item| f(item, ws))
+        .collect()
+}
+
 impl Seats<'_> {
     /// The shadows of every body but `bodies`, at their poses now.
     fn others(&self, bodies: &[usize], ws: &mut Workspace) -> Mask {
@@ -128,17 +144,19 @@ impl Seats<'_> {
         // `on[a][b]`: the change of wrong pixels of block `a` seated on `b`'s place, over
         // the picture without both.
         let n = blocks.len();
+        let pairs: Vec<(usize, usize, Place)> = (0..n * n)
+            .map(|k| (k / n, k % n))
+            .filter(|&(a, b)| shape(a) != shape(b))
+            .filter_map(|(a, b)| Some((a, b, self.place(blocks[b])?)))
+            .collect();
+        let seated = each(self.problem, &pairs, |&(a, b, place), ws| {
+            let i = blocks[a];
+            let seat = Seat::new(self.problem, i, &self.others(&[i, blocks[b]], ws));
+            seat_pose(&seat, self.now[i].1, place, 1, ws).map(|(cost, _, _)| cost - seat.base)
+        });
         let mut on = vec![vec![None; n]; n];
-        for (a, &i) in blocks.iter().enumerate() {
-            for (b, &j) in blocks.iter().enumerate() {
-                let Some(place) = self.place(j).filter(|_| shape(a) != shape(b)) else {
-                    continue;
-                };
-                let seat = Seat::new(self.problem, i, &self.others(&[i, j], ws));
-                if let Some((cost, _, _)) = seat_pose(&seat, self.now[i].1, place, 1, ws) {
-                    on[a][b] = Some(cost - seat.base);
-                }
-            }
+        for (&(a, b, _), change) in pairs.iter().zip(seated) {
+            on[a][b] = change;
         }
         let mut cycles: Vec<(i64, Vec<usize>)> = Vec::new();
         let mut consider = |cycle: &[usize]| {
