@@ -368,13 +368,7 @@ pub fn improve(
         return report;
     }
     let mut search = Search::new(problem, held, weights);
-    let mut scratch: Vec<Scratch> = (0..pool.current_num_threads())
-        .map(|_| Scratch {
-            ws: problem.workspace(),
-            candidate: params.to_vec(),
-            flight: FreeFlight::default(),
-        })
-        .collect();
+    let mut scratch = Scratch::per_thread(problem, params, pool);
     let mut exchanges: Vec<Exchange> = Vec::new();
     let mut trade_offers: Vec<Trade> = Vec::new();
     let exchanges_wanted = exchange_pairs(scene, &movable) <= MAX_EXCHANGE_PAIRS;
@@ -408,22 +402,13 @@ pub fn improve(
             exchanges_wanted,
             trades: &trades,
         };
-        // Every move of the round, evaluated, each beside the others; the best few are
-        // then polished.
-        let mut offers = Vec::new();
-        let mut mesh_trades = 0..0;
-        exchanges.clear();
-        let parts = beside(pool, &mut search, MOVES.to_vec(), &mut scratch, |m, out| {
-            m.offer(&round, out)
-        });
-        for part in parts {
-            if !part.mesh_trades.is_empty() {
-                let at = offers.len();
-                mesh_trades = at + part.mesh_trades.start..at + part.mesh_trades.end;
-            }
-            offers.extend(part.list);
-            exchanges.extend(part.exchanges);
-        }
+        // Every move of the round, evaluated; the best few are then polished.
+        let Offered {
+            list: mut offers,
+            exchanges: offered,
+            mesh_trades,
+        } = offer_all(pool, &round, &mut search, &mut scratch);
+        exchanges = offered;
         trade_offers = offers[mesh_trades]
             .iter()
             .map(|o| search.trade(o))
@@ -622,6 +607,45 @@ struct Scratch {
     ws: Workspace,
     candidate: Vec<f64>,
     flight: FreeFlight,
+}
+
+impl Scratch {
+    /// One for each of `pool`'s threads.
+    fn per_thread(problem: &Problem, params: &[f64], pool: &rayon::ThreadPool) -> Vec<Scratch> {
+        (0..pool.current_num_threads())
+            .map(|_| Scratch {
+                ws: problem.workspace(),
+                candidate: params.to_vec(),
+                flight: FreeFlight::default(),
+            })
+            .collect()
+    }
+}
+
+/// Every move of `round`, evaluated, each beside the others ([`beside`]): their offers
+/// and exchanges in the registry's order, and where the trades of meshes are among them.
+fn offer_all<'a>(
+    pool: &rayon::ThreadPool,
+    round: &Round,
+    search: &mut Search<'a>,
+    scratch: &mut [Scratch],
+) -> Offered {
+    let mut all = Offered {
+        list: Vec::new(),
+        exchanges: Vec::new(),
+        mesh_trades: 0..0,
+    };
+    for part in beside(pool, search, MOVES.to_vec(), scratch, |m, out| {
+        m.offer(round, out)
+    }) {
+        if !part.mesh_trades.is_empty() {
+            let at = all.list.len();
+            all.mesh_trades = at + part.mesh_trades.start..at + part.mesh_trades.end;
+        }
+        all.list.extend(part.list);
+        all.exchanges.extend(part.exchanges);
+    }
+    all
 }
 
 /// What a part of a round offered ([`Offers`] without its scratch).
