@@ -315,18 +315,21 @@ fn solve_into(
         return Ok(solution);
     }
     // The pictures and exports launch from where the solution does (free positions).
-    // The plot is drawn on one core while the other draws the pictures and writes the
-    // exports: each takes a hundredth of a second or two, a tenth of a small solve.
+    // The plot, the pictures and exports, and what launcher it needs are drawn side by
+    // side: each takes a tenth of a second or less, a tenth of a small solve, and the
+    // plot and the pictures use one core each.
     let placed = placed_problem(problem, &solution);
     let problem = placed.as_ref().unwrap_or(problem);
-    let (plotted, pictures) = rayon::join(plot, || {
-        write_pictures_and_exports(&out, problem, &solution)
+    let (plotted, (pictures, needs)) = rayon::join(plot, || {
+        rayon::join(
+            || write_pictures_and_exports(&out, problem, &solution),
+            || write_needs(&out, problem, &solution, opts.threads),
+        )
     });
     plotted?;
     let written = pictures?;
-    clock.lap("convergence plot beside shadow, overlay, preview and exports");
-    let needs = write_needs(&out, problem, &solution, opts.threads)?;
-    clock.lap("what launcher it needs");
+    let needs = needs?;
+    clock.lap("convergence plot, pictures, exports and what launcher it needs");
     let report = crate::output::report::write_report(&out, &solution)?;
     clock.lap("report page");
     print_summary(scene, problem, &solution, &out, &written);
