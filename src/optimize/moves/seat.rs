@@ -42,7 +42,7 @@ impl Move for Seat {
         } else {
             r.meshes.to_vec()
         };
-        let owned = seats::each(problem, &own, |&i, ws| seats.own(i, ws));
+        let owned = seats::each(problem, &own, out.ws, |&i, ws| seats.own(i, ws));
         for (&i, found) in own.iter().zip(owned) {
             if let Some((_, pose)) = found.filter(|f| f.0 < r.wrong) {
                 seat(r, &[(i, pose)], out);
@@ -57,13 +57,15 @@ impl Move for Seat {
             .flat_map(|(a, &i)| r.meshes[a + 1..].iter().map(move |&j| (i, j)))
             .filter(|&(i, j)| r.exchanges_wanted && exchangeable(&problem.scene, i, j))
             .collect();
-        let scans = seats::each(problem, &pairs, |&(i, j), ws| seats.pair(i, j, 0, ws));
+        let scans = seats::each(problem, &pairs, out.ws, |&(i, j), ws| {
+            seats.pair(i, j, 0, ws)
+        });
         let mut scanned: Vec<(i64, usize, usize)> = (pairs.iter().zip(scans))
             .filter_map(|(&(i, j), found)| Some((found?.0, i, j)))
             .collect();
         scanned.sort();
         scanned.truncate(SEAT_PAIRS);
-        let refined = seats::each(problem, &scanned, |&(_, i, j), ws| {
+        let refined = seats::each(problem, &scanned, out.ws, |&(_, i, j), ws| {
             seats.pair(i, j, SEAT_KEPT, ws)
         });
         for (&(_, i, j), found) in scanned.iter().zip(refined) {
@@ -93,7 +95,7 @@ impl Move for Seat {
             };
             let first = out.list.len();
             let cycles = seats.trade_scan(group, cap, out.ws);
-            let found = seats::each(problem, &cycles, |cycle, ws| {
+            let found = seats::each(problem, &cycles, out.ws, |cycle, ws| {
                 seats.many(cycle, SEAT_KEPT, ws)
             });
             for (cycle, found) in cycles.iter().zip(found) {

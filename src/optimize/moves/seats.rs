@@ -25,12 +25,17 @@ pub(super) struct Seats<'a> {
 /// with a workspace of its own; the results in the items' order. Every seat sets up the
 /// workspace it reads ([`Seats::others`]), so they are those of the items one after the
 /// other. A round's seats are its costliest moves: hundreds of poses drawn per seat.
+/// One item, or one thread, runs on the caller's `ws`, with no workspace made for it.
 pub(super) fn each<T: Sync, R: Send>(
     problem: &Problem,
     items: &[T],
+    ws: &mut Workspace,
     f: impl Fn(&T, &mut Workspace) -> R + Sync,
 ) -> Vec<R> {
     use rayon::prelude::*;
+    if items.len() < 2 || rayon::current_num_threads() < 2 {
+        return items.iter().map(|item| f(item, ws)).collect();
+    }
     items
         .par_iter()
         .map_init(|| problem.workspace(), |ws, item| f(item, ws))
@@ -149,7 +154,7 @@ impl Seats<'_> {
             .filter(|&(a, b)| shape(a) != shape(b))
             .filter_map(|(a, b)| Some((a, b, self.place(blocks[b])?)))
             .collect();
-        let seated = each(self.problem, &pairs, |&(a, b, place), ws| {
+        let seated = each(self.problem, &pairs, ws, |&(a, b, place), ws| {
             let i = blocks[a];
             let seat = Seat::new(self.problem, i, &self.others(&[i, blocks[b]], ws));
             seat_pose(&seat, self.now[i].1, place, 1, ws).map(|(cost, _, _)| cost - seat.base)
