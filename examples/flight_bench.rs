@@ -1,6 +1,6 @@
 //! Accuracy and cost of `FreeFlight` (run with `cargo run --release --example flight_bench`).
 use bsa::geometry::shape::{MassProperties, Shape};
-use bsa::sim::flight::{FlightConfig, FreeFlight, LaunchState};
+use bsa::sim::flight::{integrate_grids, FlightConfig, FreeFlight, LaunchState};
 use glam::{DQuat, DVec3};
 use std::hint::black_box;
 use std::time::Instant;
@@ -20,6 +20,45 @@ fn energy(f: &FreeFlight, t: f64) -> f64 {
 fn cost(mp: &MassProperties, w: DVec3, t_max: f64, cfg: &FlightConfig) -> f64 {
     (0..5)
         .map(|_| cost_once(mp, w, t_max, cfg))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// [`cost`] per flight of four flights started together and integrated side by side
+/// (`reset_without_grid`, then `integrate_grids`, as a batch of samples is).
+fn cost_abreast(mp: &MassProperties, w: DVec3, t_max: f64, cfg: &FlightConfig) -> f64 {
+    (0..5)
+        .map(|_| {
+            let mut flights = vec![FreeFlight::default(); 4];
+            let q0 = DQuat::from_axis_angle(DVec3::new(1.0, -0.5, 0.3).normalize(), 0.8);
+            let n = 100;
+            let start = Instant::now();
+            let mut acc = DQuat::IDENTITY;
+            for i in 0..n {
+                for (j, f) in flights.iter_mut().enumerate() {
+                    let wi = w * (1.0 + 1e-4 * (4 * i + j) as f64);
+                    f.reset_without_grid(
+                        black_box(mp),
+                        LaunchState {
+                            origin: DVec3::ZERO,
+                            orientation: q0,
+                            velocity: DVec3::X,
+                            angular_velocity: wi,
+                        },
+                        DVec3::NEG_Z * 9.81,
+                        t_max,
+                        cfg,
+                    );
+                }
+                integrate_grids(&mut flights);
+                for f in &flights {
+                    for k in 1..=4 {
+                        acc += f.orientation(black_box(t_max * k as f64 / 4.0 - 0.0123));
+                    }
+                }
+            }
+            black_box(acc);
+            start.elapsed().as_secs_f64() / (4 * n) as f64 * 1e6
+        })
         .fold(f64::INFINITY, f64::min)
 }
 
@@ -132,6 +171,10 @@ fn main() {
     println!(
         "  asymmetric brick |w| 19.3: {:.3} us",
         cost(&brick, w, 1.5, &cfg)
+    );
+    println!(
+        "  asymmetric brick |w| 19.3, four side by side: {:.3} us each",
+        cost_abreast(&brick, w, 1.5, &cfg)
     );
     println!(
         "  asymmetric brick |w| 5:    {:.3} us",

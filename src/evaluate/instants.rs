@@ -36,7 +36,7 @@ use crate::geometry::distance::{signed_distance, table_signed_distance};
 use crate::scene::{Hint, HoldObjective, Launch, LaunchPositions, Scene, Stage};
 use crate::shadow::mask::Mask;
 use crate::sim::drag::{BodyDrag, DragConfig};
-use crate::sim::flight::{FreeFlight, LaunchState};
+use crate::sim::flight::{integrate_grids, FreeFlight, LaunchState};
 use crate::sim::launch_error::{draw_errors, BodyError, Tolerances};
 
 /// Position values per occluder in the parameter vector when launch positions are free:
@@ -321,7 +321,8 @@ impl Problem {
     }
 
     /// Start occluder `i`'s flight in `flight` for launch `state` with the plan's physics
-    /// (drag coefficient off by `1 + cd_error`), up to `t_max`.
+    /// (drag coefficient off by `1 + cd_error`), up to `t_max`. The caller integrates the
+    /// grids of the flights it started with [`integrate_grids`], side by side.
     pub(super) fn start_flight(
         &self,
         flight: &mut FreeFlight,
@@ -331,7 +332,7 @@ impl Problem {
         t_max: f64,
     ) {
         let o = &self.scene.occluders[i];
-        flight.reset(&o.mass, state, self.scene.gravity, t_max, &self.flight);
+        flight.reset_without_grid(&o.mass, state, self.scene.gravity, t_max, &self.flight);
         if let Physics::Air { config, bodies } = &self.plan.physics {
             let body = if cd_error != 0.0 {
                 bodies[i].with_cd_factor(1.0 + cd_error)
@@ -386,7 +387,7 @@ impl Problem {
         ws: &mut Workspace,
     ) -> Evaluation {
         let n = self.scene.occluders.len();
-        let outcome = self.fly_with(held, params, ws);
+        let outcome = self.land(held, ws);
         let (bad, depth) = if self.plan.free_positions {
             self.launch_violations(held, params)
         } else {
@@ -530,6 +531,7 @@ impl Problem {
                 let t_max = self.plan.horizon + e.timing.abs();
                 self.start_flight(&mut scratch.flights[i], i, state, e.cd, t_max);
             }
+            integrate_grids(&mut scratch.flights);
             let mut mine = [0.0; TERM_COUNT];
             for (k, inst) in self.plan.instants.iter().enumerate() {
                 for (i, o) in self.scene.occluders.iter().enumerate() {

@@ -36,7 +36,7 @@ use crate::scene::{Launch, Scene};
 use crate::shadow::mask::Mask;
 use crate::shadow::raster::{MeshSilhouette, RasterScratch, ShadowCamera};
 use crate::sim::contact::BallStart;
-use crate::sim::flight::{FlightConfig, FreeFlight};
+use crate::sim::flight::{integrate_grids, FlightConfig, FreeFlight};
 
 mod contacts;
 pub mod instants;
@@ -49,6 +49,10 @@ pub use crate::scene::MAX_TURN;
 /// its own (masks, flights), and beyond the machine's cores more threads only cost (a
 /// solve of three blocks took 50 s on 1024 threads of 2 cores, 0.4 s on one).
 pub const MAX_THREADS: usize = 256;
+
+/// The most samples [`Problem::evaluate_held_draws`] takes at once: as many as
+/// [`integrate_grids`] integrates side by side.
+pub const MAX_BATCH: usize = 4;
 
 /// The phases [`Problem::profile`] times, in the order a sample runs them.
 pub const PROFILE_PHASES: [&str; 11] = [
@@ -125,6 +129,9 @@ fn reg_term(params: &[f64], i: usize) -> f64 {
 /// Per-worker reusable buffers.
 pub struct Workspace {
     flights: Vec<FreeFlight>,
+    /// The flights of a batch's later samples ([`Problem::evaluate_held_draws`]), each
+    /// swapped into `flights` while its sample is evaluated.
+    batch: Vec<Vec<FreeFlight>>,
     pub mask: Mask,
     raster: RasterScratch,
     world_vertices: Vec<DVec3>,
@@ -298,7 +305,8 @@ impl Problem {
             return held;
         }
         let kept: Vec<bool> = held.varying.iter().map(|v| !v).collect();
-        self.launch(Some(&kept), base, &mut ws);
+        self.launch(Some(&kept), base, &mut ws.flights);
+        integrate_grids(&mut ws.flights);
         for i in 0..n {
             if !held.varying[i] {
                 held.balls[i] = BallStart::of(&self.body(i, &ws.flights));
@@ -407,6 +415,9 @@ impl Problem {
             .unwrap_or(8);
         Workspace {
             flights: (0..n).map(|_| FreeFlight::default()).collect(),
+            batch: (1..MAX_BATCH)
+                .map(|_| (0..n).map(|_| FreeFlight::default()).collect())
+                .collect(),
             mask: Mask::new(self.canvas.width_px, self.canvas.height_px),
             raster: RasterScratch::default(),
             world_vertices: Vec::with_capacity(max_vertices),
@@ -421,9 +432,9 @@ impl Problem {
         }
     }
 
-    /// The memory one [`Workspace`] takes (bytes), about: its shadow mask, a pose and a
-    /// flight per body (an asymmetric body's grid of orientations, a few hundred), and
-    /// the pair contacts.
+    /// The memory one [`Workspace`] takes (bytes), about: its shadow mask, a pose per body
+    /// and a flight per body and sample of a batch (an asymmetric body's grid of
+    /// orientations, a few hundred), and the pair contacts.
     pub fn workspace_bytes(&self) -> usize {
         let n = self.scene.occluders.len();
         let mask = Mask::new(1, 1);
@@ -431,7 +442,7 @@ impl Problem {
         std::mem::size_of::<Workspace>()
             + std::mem::size_of_val(&mask)
             + 8 * words
-            + n * (std::mem::size_of::<FreeFlight>() + 32 * 300 + 64)
+            + MAX_BATCH * n * (std::mem::size_of::<FreeFlight>() + 32 * 300 + 64)
             + 9 * n * n.saturating_sub(1) / 2
     }
 
@@ -469,14 +480,77 @@ impl Problem {
         draw: u64,
         ws: &mut Workspace,
     ) -> Evaluation {
-        debug_assert_eq!(params.len(), self.variable_count());
-        if params.iter().any(|x| !x.is_finite()) || self.spins_too_fast(params) {
+        if !self.launchable(params) {
             return Evaluation::diverged();
         }
+        self.launch(held.map(|h| &h.varying[..]), params, &mut ws.flights);
+        integrate_grids(&mut ws.flights);
+        self.evaluate_launched(held, params, weights, draw, ws)
+    }
+
+    /// [`Problem::evaluate_held_draw`] of each sample of `params` (at most [`MAX_BATCH`])
+    /// into `out`. The samples' flights are started first and their grids integrated
+    /// side by side ([`integrate_grids`]), where one sample's grid alone is a serial chain
+    /// that leaves the core waiting; then each sample is evaluated in turn. The same
+    /// evaluations, bit for bit, as one sample at a time.
+    pub fn evaluate_held_draws(
+        &self,
+        held: &Held,
+        params: &[Vec<f64>],
+        weights: &Weights,
+        draw: u64,
+        ws: &mut Workspace,
+        out: &mut [Evaluation],
+    ) {
+        assert!(params.len() <= MAX_BATCH && params.len() == out.len());
+        let mut launched = [false; MAX_BATCH];
+        for (k, p) in params.iter().enumerate() {
+            launched[k] = self.launchable(p);
+            if launched[k] {
+                let flights = match k {
+                    0 => &mut ws.flights,
+                    _ => &mut ws.batch[k - 1],
+                };
+                self.launch(Some(&held.varying), p, flights);
+            }
+        }
+        let later = ws.batch[..params.len().saturating_sub(1)].iter_mut();
+        integrate_grids(ws.flights.iter_mut().chain(later.flatten()));
+        for (k, (p, slot)) in params.iter().zip(out).enumerate() {
+            if !launched[k] {
+                *slot = Evaluation::diverged();
+                continue;
+            }
+            if k > 0 {
+                std::mem::swap(&mut ws.flights, &mut ws.batch[k - 1]);
+            }
+            *slot = self.evaluate_launched(Some(held), p, weights, draw, ws);
+            if k > 0 {
+                std::mem::swap(&mut ws.flights, &mut ws.batch[k - 1]);
+            }
+        }
+    }
+
+    /// Whether a sample can be flown: every value finite, and no body spun past
+    /// [`MAX_TURN`] (an evaluation of one that cannot is [`Evaluation::diverged`]).
+    fn launchable(&self, params: &[f64]) -> bool {
+        debug_assert_eq!(params.len(), self.variable_count());
+        params.iter().all(|x| x.is_finite()) && !self.spins_too_fast(params)
+    }
+
+    /// The rest of [`Problem::evaluate_sample`] once its varying flights are in `ws`.
+    fn evaluate_launched(
+        &self,
+        held: Option<&Held>,
+        params: &[f64],
+        weights: &Weights,
+        draw: u64,
+        ws: &mut Workspace,
+    ) -> Evaluation {
         if !self.plan.simple() {
             return self.evaluate_plan(held, params, weights, draw, ws);
         }
-        let outcome = self.fly_with(held, params, ws);
+        let outcome = self.land(held, ws);
         self.shadow_with(held.map(|h| &h.mask), held.map(|h| &h.varying[..]), ws);
         let mut raw = [0.0; TERM_COUNT];
         let counts = energy::image_terms(&self.target, &ws.mask, weights, &mut raw);
@@ -500,13 +574,14 @@ impl Problem {
         })
     }
 
-    /// Step 1: start the exact free flight of every launched body (that varies).
-    fn launch(&self, which: Option<&[bool]>, params: &[f64], ws: &mut Workspace) {
+    /// Step 1: start the exact free flight of every launched body (that varies) in
+    /// `flights`; the caller integrates their grids ([`integrate_grids`]).
+    fn launch(&self, which: Option<&[bool]>, params: &[f64], flights: &mut [FreeFlight]) {
         let scene = &self.scene;
         for (i, o) in scene.occluders.iter().enumerate() {
             if o.launched && among(which, i) {
                 let state = self.launch_state(params, i);
-                self.start_flight(&mut ws.flights[i], i, state, 0.0, self.plan.horizon);
+                self.start_flight(&mut flights[i], i, state, 0.0, self.plan.horizon);
             }
         }
     }
@@ -517,9 +592,15 @@ impl Problem {
     }
 
     fn fly_with(&self, held: Option<&Held>, params: &[f64], ws: &mut Workspace) -> Outcome {
+        self.launch(held.map(|h| &h.varying[..]), params, &mut ws.flights);
+        integrate_grids(&mut ws.flights);
+        self.land(held, ws)
+    }
+
+    /// Steps 2-3 after [`Problem::launch`]: first contact, poses at `t`.
+    pub(super) fn land(&self, held: Option<&Held>, ws: &mut Workspace) -> Outcome {
         let scene = &self.scene;
         let t = scene.t;
-        self.launch(held.map(|h| &h.varying[..]), params, ws);
         let outcome = self.first_contact(held, ws);
         for i in 0..scene.occluders.len() {
             ws.poses[i] = match held {
@@ -617,7 +698,10 @@ impl Problem {
             }
             start.elapsed().as_secs_f64() * 1e6 / reps as f64
         };
-        let us = time(&mut || self.launch(None, params, ws));
+        let us = time(&mut || {
+            self.launch(None, params, &mut ws.flights);
+            integrate_grids(&mut ws.flights);
+        });
         out.push((PROFILE_PHASES[0].into(), us));
         let us = time(&mut || {
             std::hint::black_box(self.first_contact(None, ws));

@@ -1,4 +1,5 @@
 use super::*;
+use crate::sim::flight::RotationKind;
 
 fn scene(name: &str) -> Problem {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -126,6 +127,57 @@ fn held_samples_are_bit_identical_to_full_ones_on_every_example() {
     }
     // The comparison covers samples with contacts, not only clean flights.
     assert!(contacts > 10, "only {contacts} samples with a contact");
+}
+
+#[test]
+fn samples_evaluated_in_a_batch_give_the_bits_of_each_alone() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    let bits = |e: &Evaluation| {
+        let mut b: Vec<u64> = e.raw.iter().map(|x| x.to_bits()).collect();
+        b.extend([e.total.to_bits(), e.iou.to_bits()]);
+        (b, e.outcome)
+    };
+    let mut tumbling = 0;
+    for name in ["fly", "tbc", "thinker"] {
+        let p = scene(name);
+        let n = p.scene.occluders.len();
+        let all = Weights::all_ones();
+        let (mut alone_ws, mut batch_ws) = (p.workspace(), p.workspace());
+        for vary in [vec![0], vec![1, 2], (0..n).collect()] {
+            let base = p.scene.start_parameters();
+            let held = p.hold(&base, &vary);
+            for size in 1..=MAX_BATCH {
+                let params: Vec<Vec<f64>> = (0..size)
+                    .map(|k| {
+                        let mut params = base.clone();
+                        for &i in &vary {
+                            for x in &mut params[6 * i..6 * i + 6] {
+                                *x += rng.random_range(-2.0..2.0);
+                            }
+                        }
+                        // One sample of the largest batch spins past what a launch can.
+                        if k == 2 && size == MAX_BATCH {
+                            params[6 * vary[0] + 3] = 1e3;
+                        }
+                        params
+                    })
+                    .collect();
+                let mut out = vec![Evaluation::diverged(); size];
+                p.evaluate_held_draws(&held, &params, &all, 0, &mut batch_ws, &mut out);
+                for (params, batched) in params.iter().zip(&out) {
+                    let alone = p.evaluate_held(&held, params, &all, &mut alone_ws);
+                    assert_eq!(bits(&alone), bits(batched), "{name}: vary {vary:?}");
+                }
+                tumbling += vary
+                    .iter()
+                    .filter(|&&i| alone_ws.flights[i].rotation_kind() == RotationKind::Asymmetric)
+                    .count();
+            }
+        }
+    }
+    // The batches integrate grids side by side, not only closed forms.
+    assert!(tumbling > 10, "only {tumbling} tumbling flights");
 }
 
 /// Every body 1 m above the image centre, unturned, but the first, moved so that its

@@ -8,7 +8,7 @@ use std::sync::Mutex;
 use rayon::prelude::*;
 
 use crate::energy::DIVERGED_ENERGY;
-use crate::evaluate::{Evaluation, Held, Problem, Workspace};
+use crate::evaluate::{Evaluation, Held, Problem, Workspace, MAX_BATCH};
 use crate::optimize::cmaes::{Cmaes, CmaesConfig, StopReason};
 use crate::scene::{Contacts, Stage};
 
@@ -76,16 +76,26 @@ impl Pool {
     ) {
         let base = held.base();
         let full = base.len();
+        // Batches of samples (their flights' grids integrated side by side), as many as
+        // the threads need to share the population evenly, at most `MAX_BATCH`.
+        let per = out
+            .len()
+            .div_ceil(self.workspaces.len())
+            .clamp(1, MAX_BATCH);
         self.pool.install(|| {
-            out.par_iter_mut().enumerate().for_each_init(
-                || vec![0.0; full],
-                |params, (k, slot)| {
-                    problem.expand(base, &stage.vary, &candidates[k * n..(k + 1) * n], params);
+            out.par_chunks_mut(per).enumerate().for_each_init(
+                || vec![vec![0.0; full]; per],
+                |params, (c, slots)| {
+                    for (j, params) in params[..slots.len()].iter_mut().enumerate() {
+                        let k = c * per + j;
+                        problem.expand(base, &stage.vary, &candidates[k * n..(k + 1) * n], params);
+                    }
                     let idx = rayon::current_thread_index().unwrap_or(0) % self.workspaces.len();
                     let mut ws = self.workspaces[idx]
                         .lock()
                         .unwrap_or_else(|e| e.into_inner());
-                    *slot = problem.evaluate_held_draw(held, params, &stage.weights, draw, &mut ws);
+                    let params = &params[..slots.len()];
+                    problem.evaluate_held_draws(held, params, &stage.weights, draw, &mut ws, slots);
                 },
             );
         });

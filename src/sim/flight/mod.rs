@@ -24,6 +24,9 @@ use crate::geometry::shape::MassProperties;
 use crate::scene::{Launch, Occluder};
 use crate::sim::drag::{BodyDrag, DragTrack};
 
+mod rk4;
+use rk4::{renormalize, renormalize_one, rk4_step, rk4_step_one, vec3, Quat, Wide, LANES};
+
 /// Relative tolerance under which two principal moments count as equal, so that the
 /// closed-form isotropic or axisymmetric rotation is used. At 1e-9 the closed form's
 /// error from treating them as equal is about 1e-9 of the rotation angle, far below the
@@ -165,6 +168,8 @@ pub struct FreeFlight {
     inv_h: f64,
     /// Principal-to-world quaternions at `k h`, `k = 0..=n` (asymmetric only).
     states: Vec<DQuat>,
+    /// Steps the grid takes to reach `t_max` (asymmetric only).
+    grid_steps: usize,
     /// The centre of mass flown with drag, when `drag_on` (see [`FreeFlight::set_drag`]).
     drag: DragTrack,
     drag_on: bool,
@@ -191,60 +196,11 @@ impl Default for FreeFlight {
             h: 0.0,
             inv_h: 0.0,
             states: Vec::new(),
+            grid_steps: 0,
             drag: DragTrack::default(),
             drag_on: false,
         }
     }
-}
-
-/// Time derivative of the principal-to-world quaternion: `q' = q (0, w_p) / 2` with the
-/// principal-frame angular velocity `w_p = I^-1 (q^* L q)`. Both products are polynomial
-/// in `q`, so the field is smooth off the unit sphere and RK4 keeps its fourth order even
-/// though the stage values are not normalised.
-#[inline(always)]
-fn quat_rate(q: DQuat, l_world: DVec3, half_inv_inertia: DVec3) -> DQuat {
-    // Written out in scalars: the RK4 stages form one long dependency chain, and this
-    // form has a shorter critical path than composing glam's generic products.
-    let (x, y, z, w) = (q.x, q.y, q.z, q.w);
-    let (lx, ly, lz) = (l_world.x, l_world.y, l_world.z);
-    // v = q^* L q = (w^2 - b^2) L + 2 (b . L) b - 2 w (b x L), with b = (x, y, z).
-    let s = w * w - (x * x + y * y + z * z);
-    let d = 2.0 * (x * lx + y * ly + z * lz);
-    let w2 = 2.0 * w;
-    let vx = s * lx + d * x - w2 * (y * lz - z * ly);
-    let vy = s * ly + d * y - w2 * (z * lx - x * lz);
-    let vz = s * lz + d * z - w2 * (x * ly - y * lx);
-    // Half the principal angular velocity, then q (0, w_p / 2).
-    let (ax, ay, az) = (
-        vx * half_inv_inertia.x,
-        vy * half_inv_inertia.y,
-        vz * half_inv_inertia.z,
-    );
-    DQuat::from_xyzw(
-        w * ax + y * az - z * ay,
-        w * ay + z * ax - x * az,
-        w * az + x * ay - y * ax,
-        -(x * ax + y * ay + z * az),
-    )
-}
-
-/// Pulls a nearly unit quaternion back to unit length with one Newton step for
-/// `1 / sqrt(|q|^2)`: RK4 changes the norm by far less than 1e-9 per step, so the
-/// residual (~ the square of that) is below rounding, and the step avoids the square
-/// root and division that would lengthen the serial chain of the integration.
-#[inline(always)]
-fn renormalize(q: DQuat) -> DQuat {
-    q * (1.5 - 0.5 * q.length_squared())
-}
-
-/// One classical RK4 step of length `h` for [`quat_rate`] (result not normalised).
-#[inline(always)]
-fn rk4_step(q: DQuat, h: f64, l_world: DVec3, half_inv_inertia: DVec3) -> DQuat {
-    let k1 = quat_rate(q, l_world, half_inv_inertia);
-    let k2 = quat_rate(q + k1 * (0.5 * h), l_world, half_inv_inertia);
-    let k3 = quat_rate(q + k2 * (0.5 * h), l_world, half_inv_inertia);
-    let k4 = quat_rate(q + k3 * h, l_world, half_inv_inertia);
-    q + (k1 + (k2 + k3) * 2.0 + k4) * (h / 6.0)
 }
 
 impl FreeFlight {
@@ -259,6 +215,22 @@ impl FreeFlight {
     ///
     /// Panics if a principal moment is not positive and finite.
     pub fn reset(
+        &mut self,
+        mp: &MassProperties,
+        launch: LaunchState,
+        g: DVec3,
+        t_max: f64,
+        cfg: &FlightConfig,
+    ) {
+        self.reset_without_grid(mp, launch, g, t_max, cfg);
+        integrate_grids([self]);
+    }
+
+    /// [`FreeFlight::reset`] except the asymmetric case's grid, which
+    /// [`integrate_grids`] then integrates beside other flights' grids. Until it has,
+    /// a query is still exact but marches from the launch state (the same steps, so the
+    /// same bits, at the cost of the steps up to its time).
+    pub fn reset_without_grid(
         &mut self,
         mp: &MassProperties,
         launch: LaunchState,
@@ -297,6 +269,7 @@ impl FreeFlight {
         self.precession = DVec3::ZERO;
         self.spin_body = DVec3::ZERO;
         self.states.clear();
+        self.grid_steps = 0;
         self.drag_on = false;
 
         let [i0, i1, i2] = inertia.to_array();
@@ -357,12 +330,25 @@ impl FreeFlight {
         };
         self.h = h_target;
         self.inv_h = 1.0 / self.h;
+        self.grid_steps = n;
         self.states.reserve(n + 1);
-        let mut q = qp0;
-        self.states.push(q);
-        for _ in 0..n {
-            q = renormalize(rk4_step(q, self.h, l_world, self.half_inv_inertia));
+        self.states.push(qp0);
+    }
+
+    /// The grid's steps left, as one flight.
+    fn integrate_alone(&mut self) {
+        let mut q = self.states[self.states.len() - 1];
+        for _ in 0..self.steps_left() {
+            q = renormalize_one(rk4_step_one(q, self.h, self.l_world, self.half_inv_inertia));
             self.states.push(q);
+        }
+    }
+
+    /// Steps of the asymmetric grid that [`integrate_grids`] has still to take.
+    fn steps_left(&self) -> usize {
+        match self.kind {
+            RotationKind::Asymmetric => self.grid_steps + 1 - self.states.len(),
+            _ => 0,
         }
     }
 
@@ -493,7 +479,7 @@ impl FreeFlight {
             // Within the grid: one partial step from the state at or just before t.
             let k = (s as usize).min(n);
             let tau = t - k as f64 * self.h;
-            return rk4_step(self.states[k], tau, self.l_world, self.half_inv_inertia);
+            return rk4_step_one(self.states[k], tau, self.l_world, self.half_inv_inertia);
         }
         // Outside the grid: march from the nearer end with full steps, then one partial
         // step. A NaN t falls through to a NaN quaternion without looping.
@@ -503,11 +489,70 @@ impl FreeFlight {
             (self.states[0], t, -self.h)
         };
         while remaining.abs() > self.h {
-            q = renormalize(rk4_step(q, h, self.l_world, self.half_inv_inertia));
+            q = renormalize_one(rk4_step_one(q, h, self.l_world, self.half_inv_inertia));
             remaining -= h;
         }
-        rk4_step(q, remaining, self.l_world, self.half_inv_inertia)
+        rk4_step_one(q, remaining, self.l_world, self.half_inv_inertia)
     }
+}
+
+/// Integrates the grids that [`FreeFlight::reset_without_grid`] left to do, [`LANES`]
+/// flights at a time in the lanes of one [`Wide`] integration (see [`rk4`]): the same
+/// bits as each alone, for a fraction of the time.
+pub fn integrate_grids<'a>(flights: impl IntoIterator<Item = &'a mut FreeFlight>) {
+    let mut lanes: [Option<&mut FreeFlight>; LANES] = Default::default();
+    let mut used = 0;
+    for f in flights {
+        if f.steps_left() > 0 {
+            lanes[used] = Some(f);
+            used += 1;
+            if used == LANES {
+                integrate_lanes(&mut lanes);
+                used = 0;
+            }
+        }
+    }
+    match &mut lanes[..used] {
+        [] => {}
+        [Some(f)] => f.integrate_alone(),
+        some => integrate_lanes(some),
+    }
+}
+
+/// The grids of `lanes`, side by side; empties them. A lane left unused steps on an idle
+/// state (the identity, no momentum), and one whose grid is done steps on; their results
+/// are dropped.
+fn integrate_lanes(lanes: &mut [Option<&mut FreeFlight>]) {
+    // Lane by lane: the quaternion, the step, the momentum and the half inverse moments.
+    let mut q = [[0.0; LANES], [0.0; LANES], [0.0; LANES], [1.0; LANES]];
+    let (mut h, mut l, mut half_inv) = ([0.0; LANES], [[0.0; LANES]; 3], [[0.0; LANES]; 3]);
+    let mut left = [0; LANES];
+    for (j, f) in lanes.iter().enumerate() {
+        let f = f.as_deref().expect("a flight in every lane used");
+        let last = f.states[f.states.len() - 1].to_array();
+        let (lw, hi) = (vec3(f.l_world), vec3(f.half_inv_inertia));
+        (0..4).for_each(|c| q[c][j] = last[c]);
+        (0..3).for_each(|c| (l[c][j], half_inv[c][j]) = (lw[c], hi[c]));
+        (h[j], left[j]) = (f.h, f.steps_left());
+    }
+    let (h, l, half_inv) = (
+        Wide::from_lanes(h),
+        l.map(Wide::from_lanes),
+        half_inv.map(Wide::from_lanes),
+    );
+    let mut wide = Quat(q.map(Wide::from_lanes));
+    let most = left.iter().copied().max().unwrap_or(0);
+    for step in 0..most {
+        wide = renormalize(rk4_step(wide, h, l, half_inv));
+        let q = wide.0.map(Wide::lanes);
+        for (j, f) in lanes.iter_mut().enumerate() {
+            if step < left[j] {
+                let f = f.as_deref_mut().expect("a flight in every lane used");
+                f.states.push(DQuat::from_array(q.map(|c| c[j])));
+            }
+        }
+    }
+    lanes.iter_mut().for_each(|f| *f = None);
 }
 
 #[cfg(test)]
