@@ -59,6 +59,8 @@ pub(super) struct SolveProgress {
     bar: Option<ProgressBar>,
     quiet: bool,
     last_preview: Instant,
+    /// When the last stage of any attempt ended, as this observer was told.
+    pub(super) last_stage_end: Option<Instant>,
     stages_total: usize,
     /// Iteration cap of one run of the current stage (a restart adds as many again).
     run_length: u64,
@@ -90,6 +92,7 @@ impl SolveProgress {
             quiet,
             // In the past, so that the first iteration already writes a preview.
             last_preview: Instant::now() - Duration::from_secs(1),
+            last_stage_end: None,
             stages_total: scene.stages.len(),
             attempt: 0,
         })
@@ -147,6 +150,7 @@ impl Observer for SolveProgress {
     }
 
     fn attempt_stage_finished(&mut self, s: &Solution, rows: &[SampleRecord]) {
+        self.last_stage_end = Some(Instant::now());
         if let Some(bar) = self.bar.take() {
             bar.finish_and_clear();
         }
@@ -195,6 +199,7 @@ impl Observer for SolveProgress {
     }
 
     fn stage_finished(&mut self, s: &Solution, rows: &[SampleRecord]) {
+        self.last_stage_end = Some(Instant::now());
         if let Some(bar) = self.bar.take() {
             bar.finish_and_clear();
         }

@@ -287,20 +287,21 @@ fn solve_into(
         });
         eprintln!("{}: {cost}{limit}", scene.name);
     }
-    let first_stage = options.resume.as_ref().map_or(0, |s| s.stages_completed);
     let (solution, records) = solver::solve(problem, &options, &mut observer, &INTERRUPTS);
-    // The solver's time, split: its stages, and the rest (the summary and the per-phase
-    // profile of one sample); then the wait for the files the stages left to write.
+    // The solver's time, split: every attempt's stages (up to the last stage's end, the
+    // attempts beside each other), and the rest (the summary and the per-phase profile
+    // of one sample); then the wait for the files the stages left to write.
     let solving = clock.since_lap();
+    let stages = observer.last_stage_end.map_or(0.0, |end| {
+        end.saturating_duration_since(clock.lap)
+            .as_secs_f64()
+            .min(solving)
+    });
     let waiting = observer
         .finish(&records)
         .context("while saving progress")?
         .as_secs_f64();
-    let stages: f64 = solution.stages[first_stage.min(solution.stages.len())..]
-        .iter()
-        .map(|r| r.wall_time_s)
-        .sum();
-    clock.record("stages (optimisation)", stages);
+    clock.record("stages of every attempt (optimisation)", stages);
     clock.record("summary and per-phase profile", solving - stages);
     clock.record("waiting for the files of the stages", waiting);
     clock.restart_lap();
