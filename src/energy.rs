@@ -3,7 +3,9 @@
 //! Main types: [`Term`] (the ten terms, in a fixed order), [`Weights`] (one stage's
 //! weights), [`TargetData`] (everything about the target picture that never changes:
 //! its mask, inner and outer boundary masks, moments) and [`image_terms`], which fills
-//! the image terms of a raw energy vector from a shadow mask.
+//! the image terms of a raw energy vector from a shadow mask, through the exact integer
+//! sums of [`ImageSums`] (which a held shadow keeps, so that a sample counts again only
+//! the rows it drew in).
 //!
 //! Data flow: `evaluate` rasterizes the shadow at `t` into a [`Mask`], calls
 //! [`image_terms`] for the moment, XOR and boundary terms, and adds the physics
@@ -16,7 +18,9 @@
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
-use crate::shadow::mask::{Mask, Moments};
+use std::ops::Range;
+
+use crate::shadow::mask::{Mask, MomentSums, Moments};
 
 /// Number of energy terms.
 pub const TERM_COUNT: usize = 10;
@@ -148,6 +152,11 @@ impl Weights {
     /// Whether a term contributes at all (zero-weight terms are skipped in the hot loop).
     pub fn uses(&self, t: Term) -> bool {
         self.0[t as usize] != 0.0
+    }
+
+    /// Whether any of the moment terms (d0, d1, d2) has a weight.
+    pub fn uses_moments(&self) -> bool {
+        self.uses(Term::D0) || self.uses(Term::D1) || self.uses(Term::D2)
     }
 
     /// The weights of a stage whose scene file gives none: every pixel term in units of
@@ -290,10 +299,19 @@ pub fn image_terms(
     weights: &Weights,
     raw: &mut [f64; TERM_COUNT],
 ) -> Counts {
-    let mut counts = Counts::default();
-    if weights.uses(Term::D0) || weights.uses(Term::D1) || weights.uses(Term::D2) {
-        let m = shadow.moments();
-        counts.shadow = Some(m.count as u64);
+    let sums = ImageSums::of(target, shadow, 0..usize::MAX, weights, false);
+    image_terms_of(target, &sums, weights, raw)
+}
+
+/// [`image_terms`] from the sums of a whole shadow.
+pub fn image_terms_of(
+    target: &TargetData,
+    sums: &ImageSums,
+    weights: &Weights,
+    raw: &mut [f64; TERM_COUNT],
+) -> Counts {
+    if weights.uses_moments() {
+        let m = Moments::from_sums(sums.moments);
         let tm = &target.moments;
         raw[Term::D0 as usize] = (m.count - tm.count).abs();
         match (m.centroid(), tm.centroid()) {
@@ -311,18 +329,84 @@ pub fn image_terms(
             _ => raw[Term::D2 as usize] = 0.0,
         }
     }
-    if weights.uses(Term::Xor) {
-        let x = shadow.xor_count(&target.mask);
-        counts.xor = Some(x);
+    if let (true, Some(x)) = (weights.uses(Term::Xor), sums.xor) {
         raw[Term::Xor as usize] = x as f64;
     }
     if weights.uses(Term::Inner) {
-        raw[Term::Inner as usize] = target.inner.and_not_count(shadow) as f64;
+        raw[Term::Inner as usize] = sums.inner as f64;
     }
     if weights.uses(Term::Outer) {
-        raw[Term::Outer as usize] = target.outer.and_count(shadow) as f64;
+        raw[Term::Outer as usize] = sums.outer as f64;
     }
-    counts
+    Counts {
+        shadow: sums.count,
+        xor: sums.xor,
+    }
+}
+
+/// The exact integer sums the image terms of a shadow are made of, over some of its rows:
+/// its moments, its pixels, and its pixels counted against the target's masks. Sums of
+/// disjoint rows add up to the sums of their union, so a held shadow's sums, with the
+/// rows a sample drew over replaced ([`ImageSums::replaced`]), are the sample's own.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ImageSums {
+    /// The moment sums (zero unless the weights use d0, d1 or d2).
+    moments: MomentSums,
+    /// The shadow's pixels and the pixels where it differs from the target, when counted.
+    count: Option<u64>,
+    xor: Option<u64>,
+    /// Inner-band pixels the shadow leaves bare (zero unless the weights use the term).
+    inner: u64,
+    /// Outer-band pixels the shadow covers (zero unless the weights use the term).
+    outer: u64,
+}
+
+impl ImageSums {
+    /// The sums of `shadow` over `rows` that `weights` need, and with `iou` the pixel
+    /// and XOR counts whatever the weights (the IoU takes them).
+    pub fn of(
+        target: &TargetData,
+        shadow: &Mask,
+        rows: Range<usize>,
+        weights: &Weights,
+        iou: bool,
+    ) -> ImageSums {
+        let moments = match weights.uses_moments() {
+            true => shadow.moment_sums(rows.clone()),
+            false => MomentSums::default(),
+        };
+        ImageSums {
+            moments,
+            count: match (weights.uses_moments(), iou) {
+                (true, _) => Some(moments.0[0] as u64),
+                (false, true) => Some(shadow.count_in(rows.clone())),
+                (false, false) => None,
+            },
+            xor: (weights.uses(Term::Xor) || iou)
+                .then(|| shadow.xor_count_in(&target.mask, rows.clone())),
+            inner: match weights.uses(Term::Inner) {
+                true => target.inner.and_not_count_in(shadow, rows.clone()),
+                false => 0,
+            },
+            outer: match weights.uses(Term::Outer) {
+                true => target.outer.and_count_in(shadow, rows),
+                false => 0,
+            },
+        }
+    }
+
+    /// `self` with the sums `b` of some rows taken out and `c` put in their place (`b` a
+    /// part of `self`; a count that either lacks is left out).
+    pub fn replaced(&self, b: &ImageSums, c: &ImageSums) -> ImageSums {
+        let swap = |a: Option<u64>, b: Option<u64>, c: Option<u64>| Some(a? - b? + c?);
+        ImageSums {
+            moments: self.moments.replaced(b.moments, c.moments),
+            count: swap(self.count, b.count, c.count),
+            xor: swap(self.xor, b.xor, c.xor),
+            inner: self.inner - b.inner + c.inner,
+            outer: self.outer - b.outer + c.outer,
+        }
+    }
 }
 
 /// [`iou`] of `shadow` and the target, bit for bit, with the counts [`image_terms`]

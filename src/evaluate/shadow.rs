@@ -2,53 +2,79 @@
 //! into the canvas mask (all of them, some, or some over a held shadow), and whether
 //! each shadow lies inside the picture.
 
-use glam::DVec3;
+use std::ops::Range;
+
+use glam::{DQuat, DVec3};
 
 use super::{among, Held, Problem, Workspace};
 use crate::geometry::shape::Shape;
 use crate::shadow::mask::Mask;
-use crate::shadow::raster::ClosedMesh;
+use crate::shadow::raster::{ClosedMesh, RasterScratch};
 
 impl Problem {
     /// Step 4: the shadow of every occluder at its pose in `ws.poses`, into `ws.mask`.
     pub fn shadow(&self, ws: &mut Workspace) {
-        self.shadow_with(None, None, ws)
+        self.shadow_with(None, None, ws);
     }
 
     /// The shadow of the occluders in `which` only (`which[i]`), at the poses in
     /// `ws.poses`, into `ws.mask`.
     pub fn shadow_only(&self, which: &[bool], ws: &mut Workspace) {
-        self.shadow_with(None, Some(which), ws)
+        self.shadow_with(None, Some(which), ws);
     }
 
     /// The shadow of the occluders `held` holds and of those in `which` (`which[i]`, at
     /// the poses in `ws.poses`), into `ws.mask`.
     pub fn shadow_held_and(&self, held: &Held, which: &[bool], ws: &mut Workspace) {
-        self.shadow_with(Some(&held.mask), Some(which), ws)
+        self.shadow_with(Some(&held.mask), Some(which), ws);
     }
 
     /// [`Problem::shadow`] of the occluders in `which` only, drawn over `start` (a held
-    /// shadow; OR is order-free, so the mask is the same as drawing everything).
+    /// shadow; OR is order-free, so the mask is the same as drawing everything). Returns
+    /// the rows drawn in over `start` (outside them the mask is `start`), if given one.
     pub(super) fn shadow_with(
         &self,
         start: Option<&Mask>,
         which: Option<&[bool]>,
         ws: &mut Workspace,
-    ) {
-        let cam = &self.canvas;
+    ) -> Option<Range<usize>> {
         match start {
             Some(m) => ws.mask.copy_from(m),
             None => ws.mask.clear(),
         }
-        for (i, o) in self.scene.occluders.iter().enumerate() {
-            if !among(which, i) {
-                continue;
+        let Workspace {
+            mask,
+            poses,
+            raster,
+            world_vertices,
+            ..
+        } = ws;
+        let drawn = mask.drawn_rows(|mask| {
+            for (i, _) in self.scene.occluders.iter().enumerate() {
+                if among(which, i) {
+                    self.draw(i, poses[i], mask, raster, world_vertices);
+                }
             }
-            let (p, q) = ws.poses[i];
+        });
+        start.map(|_| drawn)
+    }
+
+    /// OR occluder `i`'s shadow at pose `(p, q)` into `mask`.
+    fn draw(
+        &self,
+        i: usize,
+        (p, q): (DVec3, DQuat),
+        mask: &mut Mask,
+        raster: &mut RasterScratch,
+        world_vertices: &mut Vec<DVec3>,
+    ) {
+        let cam = &self.canvas;
+        {
+            let o = &self.scene.occluders[i];
             match &o.shape {
-                Shape::Sphere { radius } => cam.rasterize_sphere(p, *radius, &mut ws.mask),
+                Shape::Sphere { radius } => cam.rasterize_sphere(p, *radius, mask),
                 Shape::Cuboid { half_extents } => {
-                    cam.rasterize_box(p, q, *half_extents, &mut ws.mask, &mut ws.raster)
+                    cam.rasterize_box(p, q, *half_extents, mask, raster)
                 }
                 Shape::Mesh(mesh) if self.silhouettes[i].is_some() => cam.rasterize_mesh(
                     p,
@@ -58,20 +84,19 @@ impl Problem {
                         triangles: &mesh.triangles,
                         silhouette: self.silhouettes[i].as_ref().expect("checked"),
                     },
-                    &mut ws.world_vertices,
-                    &mut ws.mask,
-                    &mut ws.raster,
+                    world_vertices,
+                    mask,
+                    raster,
                 ),
                 Shape::Mesh(mesh) => {
-                    ws.world_vertices.clear();
-                    ws.world_vertices
-                        .extend(mesh.vertices.iter().map(|v| p + q * *v));
+                    world_vertices.clear();
+                    world_vertices.extend(mesh.vertices.iter().map(|v| p + q * *v));
                     cam.rasterize_triangles(
-                        &ws.world_vertices,
+                        world_vertices,
                         &mesh.triangles,
                         self.closed[i],
-                        &mut ws.mask,
-                        &mut ws.raster,
+                        mask,
+                        raster,
                     );
                 }
             }

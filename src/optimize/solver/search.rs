@@ -8,7 +8,7 @@ use std::sync::Mutex;
 use rayon::prelude::*;
 
 use crate::energy::DIVERGED_ENERGY;
-use crate::evaluate::{Evaluation, Held, Problem, Workspace, MAX_BATCH};
+use crate::evaluate::{Evaluation, Held, Problem, Workspace};
 use crate::optimize::cmaes::{Cmaes, CmaesConfig, StopReason};
 use crate::scene::{Contacts, Stage};
 
@@ -77,11 +77,11 @@ impl Pool {
         let base = held.base();
         let full = base.len();
         // Batches of samples (their flights' grids integrated side by side), as many as
-        // the threads need to share the population evenly, at most `MAX_BATCH`.
+        // the threads need to share the population evenly, at most the problem's batch.
         let per = out
             .len()
             .div_ceil(self.workspaces.len())
-            .clamp(1, MAX_BATCH);
+            .clamp(1, problem.batch_size(held));
         self.pool.install(|| {
             out.par_chunks_mut(per).enumerate().for_each_init(
                 || vec![vec![0.0; full]; per],

@@ -53,7 +53,30 @@ pub struct Moments {
     pub sum_yy: f64,
 }
 
+/// The exact integer sums behind [`Moments`] ([`Mask::moment_sums`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MomentSums(pub [u128; 6]);
+
+impl MomentSums {
+    /// `self - b + c`: the sums of a mask whose rows of `b` were replaced by those of `c`.
+    pub fn replaced(self, b: MomentSums, c: MomentSums) -> MomentSums {
+        MomentSums(std::array::from_fn(|k| self.0[k] - b.0[k] + c.0[k]))
+    }
+}
+
 impl Moments {
+    /// The moments of the sums `t` (in doubled coordinates, see [`Mask::moment_sums`]).
+    pub fn from_sums(MomentSums(t): MomentSums) -> Moments {
+        Moments {
+            count: t[0] as f64,
+            sum_x: t[1] as f64 / 2.0,
+            sum_y: t[2] as f64 / 2.0,
+            sum_xx: t[3] as f64 / 4.0,
+            sum_xy: t[4] as f64 / 4.0,
+            sum_yy: t[5] as f64 / 4.0,
+        }
+    }
+
     /// The centroid (xbar, ybar) in pixels, or `None` for an empty mask.
     pub fn centroid(&self) -> Option<DVec2> {
         if self.count > 0.0 {
@@ -489,6 +512,58 @@ impl Mask {
         pair_count_words(a, b, op)
     }
 
+    /// The words of the rows in both `a` and `b`.
+    fn words_within(&self, a: Range<usize>, b: Range<usize>) -> Range<usize> {
+        let (start, end) = (a.start.max(b.start), a.end.min(b.end));
+        if start >= end {
+            return 0..0;
+        }
+        start * self.words_per_row..end * self.words_per_row
+    }
+
+    /// Number of set pixels in `rows`.
+    pub fn count_in(&self, rows: Range<usize>) -> u64 {
+        let r = self.words_within(rows, self.rows.clone());
+        self.words[r].iter().map(|w| w.count_ones() as u64).sum()
+    }
+
+    /// [`Mask::xor_count`] over `rows` only.
+    pub fn xor_count_in(&self, other: &Mask, rows: Range<usize>) -> u64 {
+        let w = self.union_words(other);
+        let wpr = self.words_per_row.max(1);
+        let r = self.words_within(rows, w.start / wpr..w.end / wpr);
+        self.pair_count_in(other, r, |a, b| a ^ b)
+    }
+
+    /// [`Mask::and_count`] over `rows` only.
+    pub fn and_count_in(&self, other: &Mask, rows: Range<usize>) -> u64 {
+        let w = self.common_words(other);
+        let wpr = self.words_per_row.max(1);
+        let r = self.words_within(rows, w.start / wpr..w.end / wpr);
+        self.pair_count_in(other, r, |a, b| a & b)
+    }
+
+    /// [`Mask::and_not_count`] over `rows` only.
+    pub fn and_not_count_in(&self, other: &Mask, rows: Range<usize>) -> u64 {
+        self.union_words(other);
+        let r = self.words_within(rows, self.rows.clone());
+        self.pair_count_in(other, r, |a, b| a & !b)
+    }
+
+    /// Runs `draw` on this mask and returns the rows it set pixels in (`0..0` for none;
+    /// conservative, as the mask's own range is): the rows where the mask may now differ
+    /// from before.
+    pub fn drawn_rows(&mut self, draw: impl FnOnce(&mut Mask)) -> Range<usize> {
+        let before = std::mem::replace(&mut self.rows, 0..0);
+        draw(self);
+        let drawn = std::mem::replace(&mut self.rows, before);
+        if drawn.start < drawn.end {
+            self.touch_row(drawn.start);
+            self.touch_row(drawn.end - 1);
+        }
+        drawn
+    }
+
     /// Number of pixels set in exactly one of the masks.
     pub fn xor_count(&self, other: &Mask) -> u64 {
         self.pair_count(other, |a, b| a ^ b)
@@ -553,12 +628,19 @@ impl Mask {
     /// number of runs, not of pixels. Sums are kept in doubled coordinates as integers
     /// (exact) and halved once at the end.
     pub fn moments(&self) -> Moments {
-        // Totals in doubled coordinates: sum 1, sum 2x, sum 2y, sum 4x^2, sum 4xy, sum 4y^2.
-        // Each is below 4 W^3 H, 2 W^2 H^2 or 4 W H^3, so u64 holds them when both sides
-        // are at most 2^15 pixels; u128 multiplications cost a third of the time here.
+        Moments::from_sums(self.moment_sums(self.rows.clone()))
+    }
+
+    /// The integer sums of [`Mask::moments`] over `rows`, in
+    /// doubled coordinates: sum 1, sum 2x, sum 2y, sum 4x^2, sum 4xy, sum 4y^2. Sums of
+    /// disjoint rows add up to the sums of their union, exactly.
+    pub fn moment_sums(&self, rows: Range<usize>) -> MomentSums {
+        let rows = rows.start.max(self.rows.start)..rows.end.min(self.rows.end);
+        // Each sum is below 4 W^3 H, 2 W^2 H^2 or 4 W H^3, so u64 holds them when both
+        // sides are at most 2^15 pixels; u128 multiplications cost a third of the time here.
         let t = if self.width <= 1 << 15 && self.height <= 1 << 15 {
             let mut t = [0u64; 6];
-            for j in self.rows.clone() {
+            for j in rows {
                 if let Some((rn, rx2, rxx4)) = row_sums(self.row(j)) {
                     let yy = 2 * j as u64 + 1;
                     let s = [rn, rx2, rn * yy, rxx4, rx2 * yy, rn * yy * yy];
@@ -570,7 +652,7 @@ impl Mask {
             t.map(|v| v as u128)
         } else {
             let mut t = [0u128; 6];
-            for j in self.rows.clone() {
+            for j in rows {
                 if let Some((rn, rx2, rxx4)) = row_sums(self.row(j)) {
                     let (rn, rx2, yy) = (rn as u128, rx2 as u128, 2 * j as u128 + 1);
                     let s = [rn, rx2, rn * yy, rxx4 as u128, rx2 * yy, rn * yy * yy];
@@ -581,14 +663,7 @@ impl Mask {
             }
             t
         };
-        Moments {
-            count: t[0] as f64,
-            sum_x: t[1] as f64 / 2.0,
-            sum_y: t[2] as f64 / 2.0,
-            sum_xx: t[3] as f64 / 4.0,
-            sum_xy: t[4] as f64 / 4.0,
-            sum_yy: t[5] as f64 / 4.0,
-        }
+        MomentSums(t)
     }
 
     /// Binary dilation with a `k` x `k` all-ones kernel centred on each pixel (`k` odd):

@@ -335,3 +335,54 @@ fn connected_to_keeps_the_components_a_seed_touches() {
     assert_eq!(m.connected_to(&Mask::new(150, 40)).count(), 0);
     assert_eq!(m.and(&seed).count(), 2);
 }
+
+#[test]
+fn counts_and_moment_sums_of_disjoint_rows_add_up_to_the_whole() {
+    let mut rng = Rng(29);
+    for (w, h) in [(1, 1), (63, 7), (64, 40), (130, 33)] {
+        for _ in 0..8 {
+            let (a, b) = (
+                random_mask(&mut rng, w, h, 3),
+                random_mask(&mut rng, w, h, 2),
+            );
+            let k = rng.below(h + 1);
+            let (top, rest) = (0..k, k..usize::MAX);
+            assert_eq!(
+                a.count_in(top.clone()) + a.count_in(rest.clone()),
+                a.count()
+            );
+            assert_eq!(
+                a.xor_count_in(&b, top.clone()) + a.xor_count_in(&b, rest.clone()),
+                a.xor_count(&b)
+            );
+            assert_eq!(
+                a.and_count_in(&b, top.clone()) + a.and_count_in(&b, rest.clone()),
+                a.and_count(&b)
+            );
+            assert_eq!(
+                a.and_not_count_in(&b, top.clone()) + a.and_not_count_in(&b, rest.clone()),
+                a.and_not_count(&b)
+            );
+            let whole = a.moment_sums(0..usize::MAX);
+            let (t, r) = (a.moment_sums(top), a.moment_sums(rest));
+            assert_eq!(whole.0, std::array::from_fn(|i| t.0[i] + r.0[i]));
+            assert_eq!(Moments::from_sums(whole), a.moments());
+        }
+    }
+}
+
+#[test]
+fn drawn_rows_are_the_rows_a_drawing_set_pixels_in() {
+    let mut m = Mask::new(100, 50);
+    m.fill_span(3, 0, 10);
+    m.fill_span(40, 5, 6);
+    let drawn = m.drawn_rows(|m| {
+        m.fill_span(20, 1, 2);
+        m.set(25, 31);
+    });
+    assert_eq!(drawn, 20..32);
+    // The mask's own range still covers everything set.
+    assert_eq!(m.row_range(), 3..41);
+    assert_eq!(m.drawn_rows(|_| {}), 0..0);
+    assert_eq!(m.row_range(), 3..41);
+}

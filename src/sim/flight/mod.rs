@@ -134,6 +134,33 @@ pub enum RotationKind {
     Asymmetric,
 }
 
+impl RotationKind {
+    /// The law of a body with principal moments `inertia` (positive), and the principal
+    /// axis of an axisymmetric body's distinct moment.
+    fn of_moments(inertia: DVec3) -> (RotationKind, Option<usize>) {
+        let [i0, i1, i2] = inertia.to_array();
+        let tol = EQUAL_MOMENT_RTOL * inertia.max_element();
+        if inertia.max_element() - inertia.min_element() <= tol {
+            return (RotationKind::Isotropic, None);
+        }
+        let axis = if (i0 - i1).abs() <= tol {
+            2
+        } else if (i1 - i2).abs() <= tol {
+            0
+        } else if (i2 - i0).abs() <= tol {
+            1
+        } else {
+            return (RotationKind::Asymmetric, None);
+        };
+        (RotationKind::Axisymmetric, Some(axis))
+    }
+
+    /// The law [`FreeFlight::reset`] takes for a body of mass properties `mp`.
+    pub fn of(mp: &MassProperties) -> RotationKind {
+        RotationKind::of_moments(mp.principal_inertia).0
+    }
+}
+
 /// Exact torque-free flight of one rigid body launched at `t = 0` (see the module docs).
 ///
 /// Create once with [`Default`] and [`reset`](FreeFlight::reset) for every launch: the
@@ -272,26 +299,16 @@ impl FreeFlight {
         self.grid_steps = 0;
         self.drag_on = false;
 
-        let [i0, i1, i2] = inertia.to_array();
-        let tol = EQUAL_MOMENT_RTOL * inertia.max_element();
         // The closed forms keep |w| constant, so |w0| itself bounds it; the margin
         // covers rounding in the queries.
         let closed_form_bound = w.length() * (1.0 + 1e-12);
-        if inertia.max_element() - inertia.min_element() <= tol {
+        let (kind, symmetric_axis) = RotationKind::of_moments(inertia);
+        if kind == RotationKind::Isotropic {
             self.kind = RotationKind::Isotropic;
             self.precession = w;
             self.w_max = closed_form_bound;
             return;
         }
-        let symmetric_axis = if (i0 - i1).abs() <= tol {
-            Some(2)
-        } else if (i1 - i2).abs() <= tol {
-            Some(0)
-        } else if (i2 - i0).abs() <= tol {
-            Some(1)
-        } else {
-            None
-        };
         if let Some(k) = symmetric_axis {
             // Regular precession. With n(t) the world symmetry axis, w = L / I_perp +
             // beta n solves Euler's equations: it makes I(t) w = L, and n rotates about L
