@@ -257,10 +257,15 @@ fn fill_convex(poly: &[DVec2], mask: &mut Mask, lo: &mut [f64], hi: &mut [f64], 
         let Some((ja, jb)) = centre_span(Iv::new(a.y.min(b.y), a.y.max(b.y)), hp as usize) else {
             continue;
         };
-        for j in ja.max(j0)..=jb.min(j1) {
+        let (a, b) = (ja.max(j0), jb.min(j1));
+        if a > b {
+            continue;
+        }
+        // Slices rather than indices: no bounds check per row, and the loop vectorises.
+        for ((l, h), j) in lo[a..=b].iter_mut().zip(&mut hi[a..=b]).zip(a..) {
             let x = e.x_at(j as f64 + 0.5);
-            lo[j] = lo[j].min(x);
-            hi[j] = hi[j].max(x);
+            *l = l.min(x);
+            *h = h.max(x);
         }
     }
     fill_rows(mask, j0, j1, |y| {
