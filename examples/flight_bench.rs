@@ -23,13 +23,22 @@ fn cost(mp: &MassProperties, w: DVec3, t_max: f64, cfg: &FlightConfig) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The benchmark's launch with spin `w`.
+fn launch(w: DVec3) -> LaunchState {
+    LaunchState {
+        origin: DVec3::ZERO,
+        orientation: DQuat::from_axis_angle(DVec3::new(1.0, -0.5, 0.3).normalize(), 0.8),
+        velocity: DVec3::X,
+        angular_velocity: w,
+    }
+}
+
 /// [`cost`] per flight of four flights started together and integrated side by side
 /// (`reset_without_grid`, then `integrate_grids`, as a batch of samples is).
 fn cost_abreast(mp: &MassProperties, w: DVec3, t_max: f64, cfg: &FlightConfig) -> f64 {
     (0..5)
         .map(|_| {
             let mut flights = vec![FreeFlight::default(); 4];
-            let q0 = DQuat::from_axis_angle(DVec3::new(1.0, -0.5, 0.3).normalize(), 0.8);
             let n = 100;
             let start = Instant::now();
             let mut acc = DQuat::IDENTITY;
@@ -38,12 +47,7 @@ fn cost_abreast(mp: &MassProperties, w: DVec3, t_max: f64, cfg: &FlightConfig) -
                     let wi = w * (1.0 + 1e-4 * (4 * i + j) as f64);
                     f.reset_without_grid(
                         black_box(mp),
-                        LaunchState {
-                            origin: DVec3::ZERO,
-                            orientation: q0,
-                            velocity: DVec3::X,
-                            angular_velocity: wi,
-                        },
+                        launch(wi),
                         DVec3::NEG_Z * 9.81,
                         t_max,
                         cfg,
@@ -64,24 +68,12 @@ fn cost_abreast(mp: &MassProperties, w: DVec3, t_max: f64, cfg: &FlightConfig) -
 
 fn cost_once(mp: &MassProperties, w: DVec3, t_max: f64, cfg: &FlightConfig) -> f64 {
     let mut f = FreeFlight::default();
-    let q0 = DQuat::from_axis_angle(DVec3::new(1.0, -0.5, 0.3).normalize(), 0.8);
     let n = 400;
     let start = Instant::now();
     let mut acc = DQuat::IDENTITY;
     for i in 0..n {
         let wi = w * (1.0 + 1e-4 * i as f64);
-        f.reset(
-            black_box(mp),
-            LaunchState {
-                origin: DVec3::ZERO,
-                orientation: q0,
-                velocity: DVec3::X,
-                angular_velocity: wi,
-            },
-            DVec3::NEG_Z * 9.81,
-            t_max,
-            cfg,
-        );
+        f.reset(black_box(mp), launch(wi), DVec3::NEG_Z * 9.81, t_max, cfg);
         for k in 1..=4 {
             acc += f.orientation(black_box(t_max * k as f64 / 4.0 - 0.0123));
         }
