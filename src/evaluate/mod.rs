@@ -40,11 +40,14 @@ use crate::scene::{Launch, Scene};
 use crate::shadow::mask::Mask;
 use crate::shadow::raster::{MeshSilhouette, RasterScratch, ShadowCamera};
 use crate::sim::contact::BallStart;
-use crate::sim::flight::{integrate_grids, FlightConfig, FreeFlight, RotationKind};
+use crate::sim::flight::{integrate_grids, FlightConfig, FreeFlight};
 
+mod batch;
 mod contacts;
 pub mod instants;
 mod shadow;
+
+pub use batch::MAX_BATCH;
 pub use instants::{FrameIou, Instant, Physics, Plan, Robust, REFERENCE_DRAW};
 
 pub use crate::scene::MAX_TURN;
@@ -53,10 +56,6 @@ pub use crate::scene::MAX_TURN;
 /// its own (masks, flights), and beyond the machine's cores more threads only cost (a
 /// solve of three blocks took 50 s on 1024 threads of 2 cores, 0.4 s on one).
 pub const MAX_THREADS: usize = 256;
-
-/// The most samples [`Problem::evaluate_held_draws`] takes at once: as many as
-/// [`integrate_grids`] integrates side by side.
-pub const MAX_BATCH: usize = 4;
 
 /// The phases [`Problem::profile`] times, in the order a sample runs them.
 pub const PROFILE_PHASES: [&str; 11] = [
@@ -493,69 +492,6 @@ impl Problem {
         self.launch(held.map(|h| &h.varying[..]), params, &mut ws.flights);
         integrate_grids(&mut ws.flights);
         self.evaluate_launched(held, params, weights, draw, ws)
-    }
-
-    /// [`Problem::evaluate_held_draw`] of each sample of `params` (at most [`MAX_BATCH`])
-    /// into `out`. The samples' flights are started first and their grids integrated
-    /// side by side ([`integrate_grids`]), where one sample's grid alone is a serial chain
-    /// that leaves the core waiting; then each sample is evaluated in turn. The same
-    /// evaluations, bit for bit, as one sample at a time.
-    pub fn evaluate_held_draws(
-        &self,
-        held: &Held,
-        params: &[Vec<f64>],
-        weights: &Weights,
-        draw: u64,
-        ws: &mut Workspace,
-        out: &mut [Evaluation],
-    ) {
-        assert!(params.len() <= MAX_BATCH && params.len() == out.len());
-        let mut launched = [false; MAX_BATCH];
-        for (k, p) in params.iter().enumerate() {
-            launched[k] = self.launchable(p);
-            if launched[k] {
-                let flights = match k {
-                    0 => &mut ws.flights,
-                    _ => &mut ws.batch[k - 1],
-                };
-                self.launch(Some(&held.varying), p, flights);
-            }
-        }
-        let later = ws.batch[..params.len().saturating_sub(1)].iter_mut();
-        integrate_grids(ws.flights.iter_mut().chain(later.flatten()));
-        for (k, (p, slot)) in params.iter().zip(out).enumerate() {
-            if !launched[k] {
-                *slot = Evaluation::diverged();
-                continue;
-            }
-            if k > 0 {
-                std::mem::swap(&mut ws.flights, &mut ws.batch[k - 1]);
-            }
-            *slot = self.evaluate_launched(Some(held), p, weights, draw, ws);
-            if k > 0 {
-                std::mem::swap(&mut ws.flights, &mut ws.batch[k - 1]);
-            }
-        }
-    }
-
-    /// How many samples [`Problem::evaluate_held_draws`] is best given at once with
-    /// `held`: [`MAX_BATCH`] when a body it varies tumbles (three distinct moments: the
-    /// grids are what a batch integrates side by side), else 1, which leaves the threads
-    /// the finest share of a population (balls on a batch of 4 took 4 % longer).
-    pub fn batch_size(&self, held: &Held) -> usize {
-        let tumbles = self
-            .scene
-            .occluders
-            .iter()
-            .zip(&held.varying)
-            .any(|(o, &v)| {
-                v && o.launched && RotationKind::of(&o.mass) == RotationKind::Asymmetric
-            });
-        if tumbles {
-            MAX_BATCH
-        } else {
-            1
-        }
     }
 
     /// About how many rows [`energy::image_terms`] scans for the shadow `mask`: those of
