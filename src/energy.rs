@@ -15,10 +15,10 @@
 //! `E_in` counts inner-boundary pixels the shadow fails to cover, `E_out` counts
 //! outer-boundary pixels the shadow covers, and `E_XOR` counts pixels that differ.
 
+use std::ops::Range;
+
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
-
-use std::ops::Range;
 
 use crate::shadow::mask::{Mask, MomentSums, Moments};
 

@@ -34,7 +34,7 @@ impl Problem {
                     0 => &mut ws.flights,
                     _ => &mut ws.batch[k - 1],
                 };
-                self.launch(Some(&held.varying), p, flights);
+                self.start_flights(Some(&held.varying), p, flights);
             }
         }
         let later = ws.batch[..params.len().saturating_sub(1)].iter_mut();

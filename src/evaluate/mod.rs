@@ -311,7 +311,6 @@ impl Problem {
         }
         let kept: Vec<bool> = held.varying.iter().map(|v| !v).collect();
         self.launch(Some(&kept), base, &mut ws.flights);
-        integrate_grids(&mut ws.flights);
         for i in 0..n {
             if !held.varying[i] {
                 held.balls[i] = BallStart::of(&self.body(i, &ws.flights));
@@ -490,7 +489,6 @@ impl Problem {
             return Evaluation::diverged();
         }
         self.launch(held.map(|h| &h.varying[..]), params, &mut ws.flights);
-        integrate_grids(&mut ws.flights);
         self.evaluate_launched(held, params, weights, draw, ws)
     }
 
@@ -565,9 +563,15 @@ impl Problem {
         })
     }
 
-    /// Step 1: start the exact free flight of every launched body (that varies) in
-    /// `flights`; the caller integrates their grids ([`integrate_grids`]).
+    /// Step 1: the exact free flight of every launched body (that varies) in `flights`.
     fn launch(&self, which: Option<&[bool]>, params: &[f64], flights: &mut [FreeFlight]) {
+        self.start_flights(which, params, flights);
+        integrate_grids(flights);
+    }
+
+    /// [`Problem::launch`] but for the tumbling bodies' grids, which the caller integrates
+    /// ([`integrate_grids`]) beside others.
+    fn start_flights(&self, which: Option<&[bool]>, params: &[f64], flights: &mut [FreeFlight]) {
         let scene = &self.scene;
         for (i, o) in scene.occluders.iter().enumerate() {
             if o.launched && among(which, i) {
@@ -584,7 +588,6 @@ impl Problem {
 
     fn fly_with(&self, held: Option<&Held>, params: &[f64], ws: &mut Workspace) -> Outcome {
         self.launch(held.map(|h| &h.varying[..]), params, &mut ws.flights);
-        integrate_grids(&mut ws.flights);
         self.land(held, ws)
     }
 
@@ -691,7 +694,6 @@ impl Problem {
         };
         let us = time(&mut || {
             self.launch(None, params, &mut ws.flights);
-            integrate_grids(&mut ws.flights);
         });
         out.push((PROFILE_PHASES[0].into(), us));
         let us = time(&mut || {

@@ -23,6 +23,9 @@ use std::fmt;
 use std::ops::Range;
 
 mod moments;
+
+/// Every row, as the row ranges of the counts take it.
+const ALL: Range<usize> = 0..usize::MAX;
 pub use moments::{MomentSums, Moments};
 
 /// A binary image with bit-packed rows. See the module documentation for the layout.
@@ -340,8 +343,8 @@ impl Mask {
             .sum()
     }
 
-    /// Union of the two masks' row ranges, as a word range into both word vectors.
-    fn union_words(&self, other: &Mask) -> Range<usize> {
+    /// Union of the two masks' row ranges (checking that the masks are the same size).
+    fn union_rows(&self, other: &Mask) -> Range<usize> {
         assert!(
             self.width == other.width && self.height == other.height,
             "mask sizes differ: {}x{} vs {}x{}",
@@ -351,37 +354,27 @@ impl Mask {
             other.height
         );
         let (a, b) = (&self.rows, &other.rows);
-        let r = if a.start >= a.end {
+        if a.start >= a.end {
             b.clone()
         } else if b.start >= b.end {
             a.clone()
         } else {
             a.start.min(b.start)..a.end.max(b.end)
-        };
-        r.start * self.words_per_row..r.end * self.words_per_row
-    }
-
-    /// Popcount of `op(a, b)` over a word range, with four independent accumulators so
-    /// the popcounts of consecutive words can overlap in the pipeline.
-    #[inline(always)]
-    fn pair_count(&self, other: &Mask, op: impl Fn(u64, u64) -> u64 + Copy) -> u64 {
-        self.pair_count_in(other, self.union_words(other), op)
-    }
-
-    /// The words of the rows where both masks may hold set bits (an AND is zero
-    /// elsewhere).
-    fn common_words(&self, other: &Mask) -> Range<usize> {
-        // The size check, as for every pair of masks.
-        self.union_words(other);
-        let (a, b) = (&self.rows, &other.rows);
-        let (start, end) = (a.start.max(b.start), a.end.min(b.end));
-        if start >= end {
-            return 0..0;
         }
-        start * self.words_per_row..end * self.words_per_row
     }
 
-    /// [`Mask::pair_count`] over the word range `r`.
+    /// The rows where both masks may hold set bits (an AND is zero elsewhere); empty or
+    /// reversed when there are none.
+    fn common_rows(&self, other: &Mask) -> Range<usize> {
+        // The size check, as for every pair of masks.
+        self.union_rows(other);
+        let (a, b) = (&self.rows, &other.rows);
+        a.start.max(b.start)..a.end.min(b.end)
+    }
+
+    /// Popcount of `op(a, b)` over the word range `r` of both masks, with four
+    /// independent accumulators so the popcounts of consecutive words can overlap in the
+    /// pipeline.
     #[inline(always)]
     fn pair_count_in(
         &self,
@@ -424,23 +417,19 @@ impl Mask {
 
     /// [`Mask::xor_count`] over `rows` only.
     pub fn xor_count_in(&self, other: &Mask, rows: Range<usize>) -> u64 {
-        let w = self.union_words(other);
-        let wpr = self.words_per_row.max(1);
-        let r = self.words_within(rows, w.start / wpr..w.end / wpr);
+        let r = self.words_within(rows, self.union_rows(other));
         self.pair_count_in(other, r, |a, b| a ^ b)
     }
 
     /// [`Mask::and_count`] over `rows` only.
     pub fn and_count_in(&self, other: &Mask, rows: Range<usize>) -> u64 {
-        let w = self.common_words(other);
-        let wpr = self.words_per_row.max(1);
-        let r = self.words_within(rows, w.start / wpr..w.end / wpr);
+        let r = self.words_within(rows, self.common_rows(other));
         self.pair_count_in(other, r, |a, b| a & b)
     }
 
     /// [`Mask::and_not_count`] over `rows` only.
     pub fn and_not_count_in(&self, other: &Mask, rows: Range<usize>) -> u64 {
-        self.union_words(other);
+        self.union_rows(other);
         let r = self.words_within(rows, self.rows.clone());
         self.pair_count_in(other, r, |a, b| a & !b)
     }
@@ -461,17 +450,17 @@ impl Mask {
 
     /// Number of pixels set in exactly one of the masks.
     pub fn xor_count(&self, other: &Mask) -> u64 {
-        self.pair_count(other, |a, b| a ^ b)
+        self.xor_count_in(other, ALL)
     }
 
     /// Number of pixels set in both masks.
     pub fn and_count(&self, other: &Mask) -> u64 {
-        self.pair_count_in(other, self.common_words(other), |a, b| a & b)
+        self.and_count_in(other, ALL)
     }
 
     /// Number of pixels set in `self` but not in `other` (popcount of `self & !other`).
     pub fn and_not_count(&self, other: &Mask) -> u64 {
-        self.pair_count(other, |a, b| a & !b)
+        self.and_not_count_in(other, ALL)
     }
 
     /// `self & !other` as a new mask.
