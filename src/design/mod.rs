@@ -707,9 +707,7 @@ mod tests {
         let stop = add_auto(&mut cover, &mut objects, &auto);
         assert!(matches!(stop, AutoStop::Rise(_)), "{stop:?}");
         let open_leg = (0..pic.on.len())
-            .filter(|&k| {
-                cover.value[k] > 0.0 && leg((k % 320) as f64 + 0.5, (k / 320) as f64 + 0.5)
-            })
+            .filter(|&k| cover.value[k] > 0 && leg((k % 320) as f64 + 0.5, (k / 320) as f64 + 0.5))
             .count();
         assert!(
             open_leg < 16 * 80 / 4,

@@ -100,13 +100,18 @@ pub struct Placement {
 /// The pixel of the outline point `d` (m) of a shadow centred on `c`, turned by
 /// `theta`, magnified `m` times, at `metres_per_px`.
 pub fn to_pixel(c: DVec2, theta: f64, scale: f64, d: DVec2) -> DVec2 {
-    let (s, co) = theta.sin_cos();
+    to_pixel_turned(c, theta.sin_cos(), scale, d)
+}
+
+/// [`to_pixel`] with the turn's sine and cosine `(s, co)` taken once for many points.
+fn to_pixel_turned(c: DVec2, (s, co): (f64, f64), scale: f64, d: DVec2) -> DVec2 {
     c + scale * DVec2::new(d.x * co - d.y * s, -(d.x * s + d.y * co))
 }
 
-fn from_pixel(c: DVec2, theta: f64, scale: f64, p: DVec2) -> DVec2 {
+/// The outline point at pixel `p`, the shadow turned by the angle whose sine and
+/// cosine are `(s, co)` (taken once for all the pixels of a drawing).
+fn from_pixel(c: DVec2, (s, co): (f64, f64), scale: f64, p: DVec2) -> DVec2 {
     let q = (p - c) / scale;
-    let (s, co) = theta.sin_cos();
     // Inverse of to_pixel: (qx, -qy) = R(theta) d.
     let (x, y) = (q.x, -q.y);
     DVec2::new(x * co + y * s, -x * s + y * co)
@@ -116,8 +121,9 @@ fn from_pixel(c: DVec2, theta: f64, scale: f64, p: DVec2) -> DVec2 {
 pub struct Cover<'a> {
     picture: &'a Picture,
     frame: Frame,
-    /// +1 target not yet covered, -1 background not yet covered, 0 covered.
-    pub(super) value: Vec<f32>,
+    /// +1 target not yet covered, -1 background not yet covered, 0 covered (a byte a
+    /// pixel, so that the map stays in cache while the coarse search scores).
+    pub(super) value: Vec<i8>,
     /// Bit k: placement k's shadow is on (or near) this pixel.
     owners: Vec<u64>,
     /// Bit k: placement k's shadow is on this pixel (so that one placement can be lifted
@@ -170,15 +176,10 @@ impl<'a> Cover<'a> {
     }
 
     pub fn new(picture: &'a Picture, frame: Frame) -> Cover<'a> {
-        let value = picture
-            .on
-            .iter()
-            .map(|&b| if b { 1.0 } else { -1.0 })
-            .collect();
         Cover {
             picture,
             frame,
-            value,
+            value: picture.on.iter().map(|&b| worth(b)).collect(),
             owners: vec![0; picture.on.len()],
             covers: vec![0; picture.on.len()],
             heights: Vec::new(),
@@ -195,7 +196,7 @@ impl<'a> Cover<'a> {
 
     /// Target pixels not yet covered.
     pub fn open(&self) -> usize {
-        self.value.iter().filter(|&&v| v > 0.0).count()
+        self.value.iter().filter(|&&v| v > 0).count()
     }
 
     /// Pixels of the target or of a shadow: the union of the design's IoU.
@@ -204,7 +205,7 @@ impl<'a> Cover<'a> {
             .value
             .iter()
             .zip(&self.picture.on)
-            .filter(|&(&v, &on)| v == 0.0 && !on)
+            .filter(|&(&v, &on)| v == 0 && !on)
             .count();
         self.picture.count() + covered_background
     }
@@ -214,14 +215,14 @@ impl<'a> Cover<'a> {
         Picture::new(
             self.picture.width,
             self.picture.height,
-            self.value.iter().map(|&v| v > 0.0).collect(),
+            self.value.iter().map(|&v| v > 0).collect(),
         )
     }
 
     /// Score of a shadow with these samples: the gain, or `None` if it touches an
     /// earlier shadow without the height separation.
     fn score(&self, samples: &[(DVec2, f64)], c: &Candidate, half_height: f64) -> Option<f64> {
-        self.score_above(samples, None, c, half_height)
+        self.score_above(samples, None, c, c.theta.sin_cos(), half_height)
     }
 
     /// [`Cover::score`], given up (`None`) as soon as the gain cannot exceed `floor.1`
@@ -229,35 +230,43 @@ impl<'a> Cover<'a> {
     /// sum of the weights of the samples from `i` on ([`tails`]). The coarse search
     /// only keeps candidates above its sixth best, so most of them stop early, and
     /// those it keeps are scored exactly as [`Cover::score`] scores them.
+    /// `turn` is the sine and cosine of `c.theta` (the coarse search takes them once for
+    /// all its magnifications).
     fn score_above(
         &self,
         samples: &[(DVec2, f64)],
         floor: Option<(&[f64], f64)>,
         c: &Candidate,
+        turn: (f64, f64),
         half_height: f64,
     ) -> Option<f64> {
         let (w, h) = (self.picture.width, self.picture.height);
         let scale = c.m / self.frame.metres_per_px;
         let px_area = scale * scale;
         let (mut gain, mut touch) = (0.0f64, 0u64);
-        for (i, (d, a)) in samples.iter().enumerate() {
-            // Every eighth sample, so that the test costs little beside the sum.
-            if i % 8 == 0 {
-                if let Some((tail, floor)) = floor {
-                    if gain + tail[i] * px_area < floor {
-                        return None;
-                    }
+        // Eight samples at a time, so that the floor's test costs little beside the sum.
+        for (i, eight) in samples.chunks(8).enumerate() {
+            if let Some((tail, floor)) = floor {
+                if gain + tail[8 * i] * px_area < floor {
+                    return None;
                 }
             }
-            let p = to_pixel(c.centre, c.theta, scale, *d);
-            let v = if p.x < 0.0 || p.y < 0.0 || p.x >= w as f64 || p.y >= h as f64 {
-                -1.0
-            } else {
-                let k = p.y as usize * w + p.x as usize;
-                touch |= self.owners[k];
-                self.value[k] as f64
-            };
-            gain += v * a * px_area;
+            for (d, a) in eight {
+                let p = to_pixel_turned(c.centre, turn, scale, *d);
+                let v = if p.x >= 0.0 && p.y >= 0.0 && p.x < w as f64 && p.y < h as f64 {
+                    // SAFETY: 0 <= p.x < w and 0 <= p.y < h (so neither is NaN), so both
+                    // truncate to indices of the picture, as `as usize` would, without
+                    // its saturation.
+                    let (x, y): (i64, i64) =
+                        unsafe { (p.x.to_int_unchecked(), p.y.to_int_unchecked()) };
+                    let k = y as usize * w + x as usize;
+                    touch |= self.owners[k];
+                    f64::from(self.value[k])
+                } else {
+                    -1.0
+                };
+                gain += v * a * px_area;
+            }
         }
         let z = self.frame.height(c.m);
         while touch != 0 {
@@ -306,16 +315,16 @@ impl<'a> Cover<'a> {
                 let tail = tails(&samples);
                 for (k, &(x, y)) in ridge.iter().enumerate() {
                     let centre = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
-                    let thetas: Vec<f64> = if pose.outline.round() {
-                        vec![0.0]
+                    let thetas: Vec<(f64, (f64, f64))> = if pose.outline.round() {
+                        vec![(0.0, 0.0f64.sin_cos())]
                     } else {
                         let d = dirs[k];
                         let mut t = vec![d, d + 0.26, d - 0.26];
                         t.extend((0..6).map(|i| i as f64 * std::f64::consts::PI / 6.0));
-                        t
+                        t.into_iter().map(|a| (a, a.sin_cos())).collect()
                     };
                     for &m in &scales {
-                        for &theta in &thetas {
+                        for &(theta, turn) in &thetas {
                             let c = Candidate {
                                 centre,
                                 theta,
@@ -328,7 +337,8 @@ impl<'a> Cover<'a> {
                                 // would refuse it.
                                 (tail.as_slice(), f - 1e-9 * f.abs().max(1.0))
                             });
-                            if let Some(s) = self.score_above(&samples, floor, &c, pose.half_height)
+                            if let Some(s) =
+                                self.score_above(&samples, floor, &c, turn, pose.half_height)
                             {
                                 keep(&mut kept, (s, fi, c));
                             }
@@ -551,12 +561,7 @@ impl<'a> Cover<'a> {
 
     /// Redraw the value and owner maps from every placement but those in `skip`.
     fn redraw_but(&mut self, skip: &[usize]) {
-        self.value = self
-            .picture
-            .on
-            .iter()
-            .map(|&b| if b { 1.0 } else { -1.0 })
-            .collect();
+        self.value = self.picture.on.iter().map(|&b| worth(b)).collect();
         self.owners.iter_mut().for_each(|o| *o = 0);
         self.covers.iter_mut().for_each(|o| *o = 0);
         for k in 0..self.placements.len() {
@@ -613,17 +618,18 @@ impl<'a> Cover<'a> {
         let scale = p.m / self.frame.metres_per_px;
         let ((x0, x1, y0, y1), rings) = self.reach(p, pose);
         let bit = 1u64 << (index % 64);
+        let turn = p.theta.sin_cos();
         for y in y0..y1 {
             for x in x0..x1 {
                 let d = from_pixel(
                     p.centre,
-                    p.theta,
+                    turn,
                     scale,
                     DVec2::new(x as f64 + 0.5, y as f64 + 0.5),
                 );
                 let k = y * w + x;
                 if pose.outline.contains(d) {
-                    self.value[k] = 0.0;
+                    self.value[k] = 0;
                     self.owners[k] |= bit;
                     self.covers[k] |= bit;
                 } else if rings.iter().any(|r| pose.outline.contains(d + *r)) {
@@ -646,7 +652,7 @@ impl<'a> Cover<'a> {
                 if self.covers[k] & bit != 0 {
                     self.covers[k] &= !bit;
                     if self.covers[k] == 0 {
-                        self.value[k] = if self.picture.on[k] { 1.0 } else { -1.0 };
+                        self.value[k] = worth(self.picture.on[k]);
                     }
                 }
             }
@@ -662,6 +668,15 @@ impl<'a> Cover<'a> {
         } else {
             self.undraw(k, &p, &pose);
         }
+    }
+}
+
+/// What an uncovered pixel is worth: +1 on the target, -1 off it.
+fn worth(on: bool) -> i8 {
+    if on {
+        1
+    } else {
+        -1
     }
 }
 
@@ -903,7 +918,7 @@ mod tests {
         for theta in [0.0, 0.4, 2.0] {
             let d = DVec2::new(0.03, -0.01);
             let p = to_pixel(c, theta, 400.0, d);
-            assert!(from_pixel(c, theta, 400.0, p).distance(d) < 1e-12);
+            assert!(from_pixel(c, theta.sin_cos(), 400.0, p).distance(d) < 1e-12);
         }
         // Outline x at theta = 90 degrees points up the image (decreasing pixel y).
         let p = to_pixel(c, std::f64::consts::FRAC_PI_2, 100.0, DVec2::new(0.1, 0.0));
