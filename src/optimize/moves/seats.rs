@@ -327,23 +327,30 @@ fn cut_across(part: &Mask, cuts: &[f64]) -> Vec<[(DVec2, f64); 2]> {
     let angle = 0.5 * (2.0 * b).atan2(a - cc);
     let axis = DVec2::new(angle.cos(), angle.sin());
     let along = |x: usize, y: usize| (DVec2::new(x as f64, y as f64) - c).dot(axis);
-    // The part's pixels by their distance along the axis, to cut at quantiles.
-    let mut sorted: Vec<f64> = Vec::with_capacity(m.count as usize);
-    for y in 0..part.height() {
-        for x in 0..part.width() {
-            if part.get(x, y) {
-                sorted.push(along(x, y));
+    // The part's pixels (read from its rows' words, not pixel by pixel over the
+    // canvas), and their distances along the axis, to cut at quantiles.
+    let mut pixels: Vec<(usize, usize)> = Vec::with_capacity(m.count as usize);
+    for y in part.row_range() {
+        for (w, &word) in part.row(y).iter().enumerate() {
+            let mut bits = word;
+            while bits != 0 {
+                pixels.push((64 * w + bits.trailing_zeros() as usize, y));
+                bits &= bits - 1;
             }
         }
     }
+    let mut sorted: Vec<f64> = pixels.iter().map(|&(x, y)| along(x, y)).collect();
     sorted.sort_by(f64::total_cmp);
     let mut out = Vec::new();
     for &cut in cuts {
         let at = sorted[((sorted.len() as f64 * cut) as usize).min(sorted.len() - 1)];
         let side = |low: bool| {
-            let half = Mask::from_fn(part.width(), part.height(), |x, y| {
-                part.get(x, y) && (along(x, y) < at) == low
-            });
+            let mut half = Mask::new(part.width(), part.height());
+            for &(x, y) in &pixels {
+                if (along(x, y) < at) == low {
+                    half.set(x, y);
+                }
+            }
             let h = half.moments();
             h.centroid()
                 .filter(|_| h.count >= SPLIT_LEAST)
