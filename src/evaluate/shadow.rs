@@ -50,9 +50,10 @@ impl Problem {
             ..
         } = ws;
         let drawn = mask.drawn_rows(|mask| {
-            for (i, _) in self.scene.occluders.iter().enumerate() {
+            // One pose per occluder.
+            for (i, &pose) in poses.iter().enumerate() {
                 if among(which, i) {
-                    self.draw(i, poses[i], mask, raster, world_vertices);
+                    self.draw(i, pose, mask, raster, world_vertices);
                 }
             }
         });
@@ -69,36 +70,33 @@ impl Problem {
         world_vertices: &mut Vec<DVec3>,
     ) {
         let cam = &self.canvas;
-        {
-            let o = &self.scene.occluders[i];
-            match &o.shape {
-                Shape::Sphere { radius } => cam.rasterize_sphere(p, *radius, mask),
-                Shape::Cuboid { half_extents } => {
-                    cam.rasterize_box(p, q, *half_extents, mask, raster)
-                }
-                Shape::Mesh(mesh) if self.silhouettes[i].is_some() => cam.rasterize_mesh(
-                    p,
-                    q,
-                    ClosedMesh {
-                        vertices: &mesh.vertices,
-                        triangles: &mesh.triangles,
-                        silhouette: self.silhouettes[i].as_ref().expect("checked"),
-                    },
+        match (&self.scene.occluders[i].shape, &self.silhouettes[i]) {
+            (Shape::Sphere { radius }, _) => cam.rasterize_sphere(p, *radius, mask),
+            (Shape::Cuboid { half_extents }, _) => {
+                cam.rasterize_box(p, q, *half_extents, mask, raster)
+            }
+            (Shape::Mesh(mesh), Some(silhouette)) => cam.rasterize_mesh(
+                p,
+                q,
+                ClosedMesh {
+                    vertices: &mesh.vertices,
+                    triangles: &mesh.triangles,
+                    silhouette,
+                },
+                world_vertices,
+                mask,
+                raster,
+            ),
+            (Shape::Mesh(mesh), None) => {
+                world_vertices.clear();
+                world_vertices.extend(mesh.vertices.iter().map(|v| p + q * *v));
+                cam.rasterize_triangles(
                     world_vertices,
+                    &mesh.triangles,
+                    self.closed[i],
                     mask,
                     raster,
-                ),
-                Shape::Mesh(mesh) => {
-                    world_vertices.clear();
-                    world_vertices.extend(mesh.vertices.iter().map(|v| p + q * *v));
-                    cam.rasterize_triangles(
-                        world_vertices,
-                        &mesh.triangles,
-                        self.closed[i],
-                        mask,
-                        raster,
-                    );
-                }
+                );
             }
         }
     }
