@@ -30,11 +30,10 @@
 
 use glam::{DQuat, DVec3};
 
-use super::{Evaluation, Held, Problem, Workspace};
+use super::{Evaluation, Held, HeldMask, Problem, Workspace};
 use crate::energy::{self, Term, Weights, TERM_COUNT};
 use crate::geometry::distance::{signed_distance, table_signed_distance};
 use crate::scene::{Hint, HoldObjective, Launch, LaunchPositions, Scene, Stage};
-use crate::shadow::mask::Mask;
 use crate::sim::drag::{BodyDrag, DragConfig};
 use crate::sim::flight::{integrate_grids, FreeFlight, LaunchState};
 use crate::sim::launch_error::{draw_errors, BodyError, Tolerances};
@@ -211,7 +210,7 @@ impl Held {
 /// What a stage holds fixed at one instant: the held occluders' poses and shadow.
 pub struct HeldInstant {
     poses: Vec<(DVec3, DQuat)>,
-    mask: Mask,
+    mask: HeldMask,
 }
 
 /// The image and scene terms (those summed over instants).
@@ -357,7 +356,7 @@ impl Problem {
             self.shadow_only(kept, ws);
             out.push(HeldInstant {
                 poses: ws.poses.clone(),
-                mask: ws.mask.clone(),
+                mask: HeldMask::new(ws.mask.clone()),
             });
         }
         out

@@ -30,6 +30,7 @@
 use glam::{DQuat, DVec3};
 
 use std::ops::Range;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::energy::{
     self, ImageSums, TargetData, Term, Weights, DIVERGED_ENERGY, REG_ALPHA, TERM_COUNT,
@@ -136,6 +137,11 @@ pub struct Workspace {
     /// swapped into `flights` while its sample is evaluated.
     batch: Vec<Vec<FreeFlight>>,
     pub mask: Mask,
+    /// The held shadow `mask` was last drawn over and the rows drawn in (outside them
+    /// `mask` is that shadow), while `mask` is written by nothing but
+    /// [`Problem::shadow_with`]: a sample over the same held shadow restores those
+    /// rows rather than copying it whole.
+    over: Option<(u64, Range<usize>)>,
     raster: RasterScratch,
     world_vertices: Vec<DVec3>,
     /// Pose of every occluder at `t` (body origin, orientation), from the last sample.
@@ -221,6 +227,31 @@ fn among(which: Option<&[bool]>, i: usize) -> bool {
     which.is_none_or(|w| w[i])
 }
 
+/// A held shadow ([`Held`], [`instants::HeldInstant`]) and a key no other held shadow
+/// has, so that a workspace whose mask was drawn over it knows it and restores only the
+/// rows it drew in ([`Workspace`]'s `over`) instead of copying the whole shadow again.
+pub(crate) struct HeldMask {
+    mask: Mask,
+    key: u64,
+}
+
+impl HeldMask {
+    fn new(mask: Mask) -> HeldMask {
+        static NEXT: AtomicU64 = AtomicU64::new(0);
+        HeldMask {
+            mask,
+            key: NEXT.fetch_add(1, Ordering::Relaxed),
+        }
+    }
+}
+
+impl std::ops::Deref for HeldMask {
+    type Target = Mask;
+    fn deref(&self) -> &Mask {
+        &self.mask
+    }
+}
+
 /// What a stage holds fixed, computed once per stage by [`Problem::hold`] so that a
 /// sample pays only for what varies ([`Problem::evaluate_held`]): the held occluders'
 /// flights, table contacts and poses at `t`, every contact between two of them before
@@ -243,7 +274,7 @@ pub struct Held {
     /// Every contact between two held occluders up to `t`: (time, order key, i, j).
     pair_hits: Vec<(f64, usize, usize, usize)>,
     /// The held occluders' shadow at `t`, and its image sums (every term's).
-    mask: Mask,
+    mask: HeldMask,
     sums: ImageSums,
     /// Held occluders whose contacts with the varying ones do not count in
     /// [`Outcome::own_contact`]: bodies still at their start guess, which a later stage
@@ -300,7 +331,7 @@ impl Problem {
             landing: vec![None; n],
             table_hit: vec![None; n],
             pair_hits: Vec::new(),
-            mask: ws.mask.clone(),
+            mask: HeldMask::new(ws.mask.clone()),
             sums: self.image_sums(&ws.mask, 0..usize::MAX, &Weights::all_ones()),
             ignored: vec![false; n],
             instants: Vec::new(),
@@ -341,7 +372,7 @@ impl Problem {
             }
         }
         self.shadow_with(None, Some(&kept), &mut ws);
-        held.mask = ws.mask.clone();
+        held.mask = HeldMask::new(ws.mask.clone());
         held.sums = self.image_sums(&held.mask, 0..usize::MAX, &Weights::all_ones());
         held.instants = self.hold_instants(&kept, &mut ws);
         held.flights = std::mem::take(&mut ws.flights);
@@ -424,6 +455,7 @@ impl Problem {
                 .map(|_| (0..n).map(|_| FreeFlight::default()).collect())
                 .collect(),
             mask: Mask::new(self.canvas.width_px, self.canvas.height_px),
+            over: None,
             raster: RasterScratch::default(),
             world_vertices: Vec::with_capacity(max_vertices),
             poses: vec![(DVec3::ZERO, DQuat::IDENTITY); n],

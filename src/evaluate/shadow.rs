@@ -6,7 +6,7 @@ use std::ops::Range;
 
 use glam::{DQuat, DVec3};
 
-use super::{among, Held, Problem, Workspace};
+use super::{among, Held, HeldMask, Problem, Workspace};
 use crate::geometry::shape::Shape;
 use crate::shadow::mask::Mask;
 use crate::shadow::raster::{ClosedMesh, RasterScratch};
@@ -30,17 +30,23 @@ impl Problem {
     }
 
     /// [`Problem::shadow`] of the occluders in `which` only, drawn over `start` (a held
-    /// shadow; OR is order-free, so the mask is the same as drawing everything). Returns
-    /// the rows drawn in over `start` (outside them the mask is `start`), if given one.
+    /// shadow; OR is order-free, so the mask is the same as drawing everything; where the
+    /// mask was last drawn over the same one, only the rows drawn then are put back).
+    /// Returns the rows drawn in over `start` (outside them the mask is `start`), if
+    /// given one.
     pub(super) fn shadow_with(
         &self,
-        start: Option<&Mask>,
+        start: Option<&HeldMask>,
         which: Option<&[bool]>,
         ws: &mut Workspace,
     ) -> Option<Range<usize>> {
-        match start {
-            Some(m) => ws.mask.copy_from(m),
-            None => ws.mask.clear(),
+        match (start, ws.over.take()) {
+            (Some(h), Some((key, rows))) if key == h.key => {
+                ws.mask.restore_rows(h, rows);
+                debug_assert!(ws.mask == **h && ws.mask.row_range() == h.row_range());
+            }
+            (Some(h), _) => ws.mask.copy_from(h),
+            (None, _) => ws.mask.clear(),
         }
         let Workspace {
             mask,
@@ -57,6 +63,7 @@ impl Problem {
                 }
             }
         });
+        ws.over = start.map(|h| (h.key, drawn.clone()));
         start.map(|_| drawn)
     }
 

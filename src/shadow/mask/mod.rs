@@ -285,6 +285,18 @@ impl Mask {
         self.rows = r;
     }
 
+    /// [`Mask::copy_from`] for a mask that differs from `other` only in `rows`: only
+    /// those rows are written.
+    pub fn restore_rows(&mut self, other: &Mask, rows: Range<usize>) {
+        assert!(
+            self.width == other.width && self.height == other.height,
+            "mask sizes differ"
+        );
+        let wr = rows.start * self.words_per_row..rows.end * self.words_per_row;
+        self.words[wr.clone()].copy_from_slice(&other.words[wr]);
+        self.rows = other.rows.clone();
+    }
+
     /// Set every pixel (padding bits stay zero).
     pub fn fill_all(&mut self) {
         if self.width == 0 || self.height == 0 {

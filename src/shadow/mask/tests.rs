@@ -386,3 +386,21 @@ fn drawn_rows_are_the_rows_a_drawing_set_pixels_in() {
     assert_eq!(m.drawn_rows(|_| {}), 0..0);
     assert_eq!(m.row_range(), 3..41);
 }
+
+#[test]
+fn restoring_the_rows_drawn_over_a_copy_gives_the_copy_back() {
+    let mut rng = Rng(7);
+    for _ in 0..20 {
+        let base = random_mask(&mut rng, 130, 40, 30);
+        let mut m = Mask::new(130, 40);
+        m.copy_from(&base);
+        let (y0, y1) = (rng.below(40), rng.below(40));
+        let drawn = m.drawn_rows(|m| {
+            m.fill_span(y0, rng.below(60), 60 + rng.below(70));
+            m.fill_span(y1, 3, 3);
+        });
+        m.restore_rows(&base, drawn);
+        assert_eq!(m, base);
+        assert_eq!(m.row_range(), base.row_range());
+    }
+}
