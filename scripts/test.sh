@@ -7,6 +7,18 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# The builds and bpy need about 7 GB (README); a full disk would otherwise show only as a
+# failed link a quarter of an hour in. What is already built or installed here counts.
+need_kb=$((7 * 1024 * 1024))
+free_kb=$(df -Pk . | awk 'NR == 2 { print $4 }')
+built_kb=$({ du -sk target .venv-blender 2>/dev/null || true; } | awk '{ s += $1 } END { print s + 0 }')
+have_kb=$((free_kb + built_kb))
+if [ "$have_kb" -lt "$need_kb" ]; then
+    echo "scripts/test.sh: $(pwd) has $((have_kb / 1024)) MB free (counting target/ and .venv-blender/)," \
+        "and the tests need about $((need_kb / 1024)) MB; free some disk and run again" >&2
+    exit 1
+fi
+
 echo "== setup: Khronos glTF validator (npm, pinned by tools/gltf-validator/package-lock.json)"
 (cd tools/gltf-validator && npm ci --no-audit --no-fund --loglevel=error)
 echo "== setup: Blender bpy in .venv-blender (PyPI, pinned by blender/requirements.txt)"
