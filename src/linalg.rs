@@ -74,7 +74,7 @@ pub fn sym_eigen(n: usize, a: &[f64], values: &mut [f64], vectors: &mut [f64], w
 }
 
 /// Eigen-decomposition of the symmetric `n x n` matrix `a` (row-major, only read, and
-/// only its lower triangle), with [`sym_eigen`]'s convention: `values` ascending, column
+/// only its upper triangle), with [`sym_eigen`]'s convention: `values` ascending, column
 /// `k` of `vectors` (row-major) the unit eigenvector of `values[k]`; `work` must hold `n`
 /// values. Householder
 /// reduction to a tridiagonal matrix, then implicit QL with shifts on it (Bowdler,
@@ -94,10 +94,11 @@ pub fn sym_eigen_ql(
         return;
     }
     let (d, e, v) = (&mut values[..n], &mut work[..n], &mut vectors[..n * n]);
+    // `a` row-major is `a^T` column-major: its upper triangle is the lower triangle that
+    // `tred2` reads, and it leaves V column-major, which is V^T row-major, whose rows QL
+    // rotates (pairs of columns of V, contiguous).
     v.copy_from_slice(&a[..n * n]);
     tridiagonalize(n, v, d, e);
-    // QL rotates pairs of columns of V: as rows of V^T they are contiguous.
-    transpose(n, v);
     tridiagonal_ql(n, v, d, e);
     sort_ascending(n, d, v);
     transpose(n, v);
@@ -121,10 +122,12 @@ fn sort_ascending(n: usize, values: &mut [f64], vt: &mut [f64]) {
     }
 }
 
-/// `tred2`: `v` (holding the matrix, row-major) becomes the orthogonal `V` with
-/// `V^T A V` tridiagonal, of diagonal `d` and subdiagonal `e[1..]` (`e[0] = 0`).
+/// `tred2`: `v` (holding the matrix, column-major) becomes the orthogonal `V` (column-major)
+/// with `V^T A V` tridiagonal, of diagonal `d` and subdiagonal `e[1..]` (`e[0] = 0`).
+/// Column-major because its inner loops run down a column: so they read contiguous
+/// memory, and the updates vectorise.
 fn tridiagonalize(n: usize, v: &mut [f64], d: &mut [f64], e: &mut [f64]) {
-    let at = |i: usize, j: usize| i * n + j;
+    let at = |i: usize, j: usize| j * n + i;
     for j in 0..n {
         d[j] = v[at(n - 1, j)];
     }
@@ -153,9 +156,10 @@ fn tridiagonalize(n: usize, v: &mut [f64], d: &mut [f64], e: &mut [f64]) {
                 let f = d[j];
                 v[at(j, i)] = f;
                 let mut g = e[j] + v[at(j, j)] * f;
-                for k in (j + 1)..i {
-                    g += v[at(k, j)] * d[k];
-                    e[k] += v[at(k, j)] * f;
+                let column = &v[at(j + 1, j)..at(i, j)];
+                for ((&x, &dk), ek) in column.iter().zip(&d[j + 1..i]).zip(&mut e[j + 1..i]) {
+                    g += x * dk;
+                    *ek += x * f;
                 }
                 e[j] = g;
             }
@@ -170,8 +174,9 @@ fn tridiagonalize(n: usize, v: &mut [f64], d: &mut [f64], e: &mut [f64]) {
             }
             for j in 0..i {
                 let (f, g) = (d[j], e[j]);
-                for k in j..i {
-                    v[at(k, j)] -= f * e[k] + g * d[k];
+                let column = &mut v[at(j, j)..at(i, j)];
+                for ((x, &ek), &dk) in column.iter_mut().zip(&e[j..i]).zip(&d[j..i]) {
+                    *x -= f * ek + g * dk;
                 }
                 d[j] = v[at(i - 1, j)];
                 v[at(i, j)] = 0.0;
@@ -185,13 +190,17 @@ fn tridiagonalize(n: usize, v: &mut [f64], d: &mut [f64], e: &mut [f64]) {
         v[at(i, i)] = 1.0;
         let h = d[i + 1];
         if h != 0.0 {
-            for k in 0..=i {
-                d[k] = v[at(k, i + 1)] / h;
+            // Columns 0..=i, and column i + 1 (its first i + 1 rows).
+            let (left, right) = v.split_at_mut(at(0, i + 1));
+            let next = &right[..=i];
+            for (dk, &x) in d[..=i].iter_mut().zip(next) {
+                *dk = x / h;
             }
-            for j in 0..=i {
-                let g: f64 = (0..=i).map(|k| v[at(k, i + 1)] * v[at(k, j)]).sum();
-                for k in 0..=i {
-                    v[at(k, j)] -= g * d[k];
+            for column in left.chunks_exact_mut(n).take(i + 1) {
+                let column = &mut column[..=i];
+                let g: f64 = next.iter().zip(column.iter()).map(|(&a, &b)| a * b).sum();
+                for (x, &dk) in column.iter_mut().zip(&d[..=i]) {
+                    *x -= g * dk;
                 }
             }
         }
