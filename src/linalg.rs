@@ -283,7 +283,7 @@ fn tridiagonal_ql(n: usize, vt: &mut [f64], d: &mut [f64], e: &mut [f64]) {
 }
 
 /// Transpose the `n x n` row-major matrix `m` in place.
-fn transpose(n: usize, m: &mut [f64]) {
+pub fn transpose(n: usize, m: &mut [f64]) {
     for i in 0..n {
         for k in (i + 1)..n {
             m.swap(i * n + k, k * n + i);

@@ -35,7 +35,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 
-use crate::linalg::sym_eigen_ql;
+use crate::linalg::{sym_eigen_ql, transpose};
 
 /// Largest accepted condition number of the covariance matrix (ratio of its largest to
 /// its smallest eigenvalue). Beyond it the smallest axes are lost to rounding in
@@ -157,8 +157,10 @@ pub struct Cmaes {
     ps: Vec<f64>,
     /// Covariance matrix, row-major `n x n`, kept exactly symmetric.
     c: Vec<f64>,
-    /// Eigenvectors of `c` in columns (row-major `n x n`), as used for sampling.
-    b: Vec<f64>,
+    /// `B^T`: the eigenvectors of `c` in rows (row-major `n x n`). `B v` is then the sum
+    /// of `v_j` times row `j`, over contiguous rows and every component at once, each
+    /// summing its terms in the order a dot product with a row of `B` would.
+    bt: Vec<f64>,
     /// Square roots of the eigenvalues of `c` (standard deviations along `b`).
     d: Vec<f64>,
     eigenvalues: Vec<f64>,
@@ -178,6 +180,8 @@ pub struct Cmaes {
     order: Vec<usize>,
     ymean: Vec<f64>,
     zmean: Vec<f64>,
+    /// Scratch of `n` values: `D z` in `ask`; `B <z>_w`, then a row's rank-mu sums in
+    /// `tell`.
     tmp: Vec<f64>,
 
     rng: ChaCha8Rng,
@@ -258,10 +262,10 @@ impl Cmaes {
         let eigen_interval = 0.5 / ((c1 + cmu) * nf);
 
         let mut c = vec![0.0; n * n];
-        let mut b = vec![0.0; n * n];
+        let mut bt = vec![0.0; n * n];
         for i in 0..n {
             c[i * n + i] = 1.0;
-            b[i * n + i] = 1.0;
+            bt[i * n + i] = 1.0;
         }
         let window = config.stagnation_window;
         Cmaes {
@@ -282,7 +286,7 @@ impl Cmaes {
             pc: vec![0.0; n],
             ps: vec![0.0; n],
             c,
-            b,
+            bt,
             d: vec![1.0; n],
             eigenvalues: vec![1.0; n],
             eigen_work: vec![0.0; n * n],
@@ -365,12 +369,10 @@ impl Cmaes {
                 *t = di * zi;
             }
             let y = &mut self.y[k * n..(k + 1) * n];
+            times_b(&self.bt, &self.tmp, y);
             let x = &mut self.x[k * n..(k + 1) * n];
-            for i in 0..n {
-                let row = &self.b[i * n..(i + 1) * n];
-                let yi: f64 = row.iter().zip(&self.tmp).map(|(bij, tj)| bij * tj).sum();
-                y[i] = yi;
-                x[i] = self.mean[i] + self.sigma * yi;
+            for ((xi, &yi), &m) in x.iter_mut().zip(y.iter()).zip(&self.mean) {
+                *xi = m + self.sigma * yi;
             }
         }
         self.awaiting_tell = true;
@@ -445,10 +447,9 @@ impl Cmaes {
 
         // Cumulation for step-size control: p_s follows C^{-1/2} <y>_w = B <z>_w.
         let cs_factor = (self.cs * (2.0 - self.cs) * self.mueff).sqrt();
-        for i in 0..n {
-            let row = &self.b[i * n..(i + 1) * n];
-            let bz: f64 = row.iter().zip(&self.zmean).map(|(a, b)| a * b).sum();
-            self.ps[i] = (1.0 - self.cs) * self.ps[i] + cs_factor * bz;
+        times_b(&self.bt, &self.zmean, &mut self.tmp);
+        for (p, &bz) in self.ps.iter_mut().zip(&self.tmp) {
+            *p = (1.0 - self.cs) * *p + cs_factor * bz;
         }
         let ps_norm = self.ps.iter().map(|v| v * v).sum::<f64>().sqrt();
 
@@ -470,13 +471,19 @@ impl Cmaes {
         let decay = 1.0 - self.c1 - self.cmu + self.c1 * delta_h;
         // Only the upper triangle is computed and then mirrored, which keeps C exactly
         // symmetric as sym_eigen expects, and halves the cost of the rank-mu sum.
+        // Row i's rank-mu sums for every j at once, each over the steps in order: the
+        // same terms in the same order as one sum per (i, j), over contiguous steps.
         for i in 0..n {
-            for j in i..n {
-                let mut rank_mu = 0.0;
-                for (&w, &k) in self.weights.iter().zip(&self.order[..self.mu]) {
-                    let y = &self.y[k * n..(k + 1) * n];
-                    rank_mu += w * y[i] * y[j];
+            let rank_mu = &mut self.tmp[i..];
+            rank_mu.fill(0.0);
+            for (&w, &k) in self.weights.iter().zip(&self.order[..self.mu]) {
+                let y = &self.y[k * n..(k + 1) * n];
+                let wy = w * y[i];
+                for (sum, &yj) in rank_mu.iter_mut().zip(&y[i..]) {
+                    *sum += wy * yj;
                 }
+            }
+            for (j, &rank_mu) in (i..n).zip(rank_mu.iter()) {
                 let v = decay * self.c[i * n + j]
                     + self.c1 * self.pc[i] * self.pc[j]
                     + self.cmu * rank_mu;
@@ -503,9 +510,10 @@ impl Cmaes {
             n,
             &self.c,
             &mut self.eigenvalues,
-            &mut self.b,
+            &mut self.bt,
             &mut self.eigen_work,
         );
+        transpose(n, &mut self.bt);
         self.last_eigen_generation = self.generation;
         let min = self.eigenvalues[0];
         let max = self.eigenvalues[n - 1];
@@ -622,6 +630,20 @@ impl Cmaes {
 }
 
 pub mod functions;
+
+/// `out = B v` from `bt` = `B^T` (row-major `n x n`): `v_j` times row `j`, summed over
+/// `j` in order for every component at once. Each component gets the same terms in the
+/// same order (from `-0.0`, as `Iterator::sum` starts) as a dot product with a row of
+/// `B`, so the bits are the dot products'; the rows are read contiguously and the
+/// components' sums do not wait on each other.
+fn times_b(bt: &[f64], v: &[f64], out: &mut [f64]) {
+    out.fill(-0.0);
+    for (row, &vj) in bt.chunks_exact(v.len()).zip(v) {
+        for (o, &b) in out.iter_mut().zip(row) {
+            *o += b * vj;
+        }
+    }
+}
 
 #[cfg(test)]
 mod tests;
