@@ -161,7 +161,7 @@ pub struct Cmaes {
     /// of `v_j` times row `j`, over contiguous rows and every component at once, each
     /// summing its terms in the order a dot product with a row of `B` would.
     bt: Vec<f64>,
-    /// Square roots of the eigenvalues of `c` (standard deviations along `b`).
+    /// Square roots of the eigenvalues of `c` (standard deviations along the rows of `bt`).
     d: Vec<f64>,
     eigenvalues: Vec<f64>,
     eigen_work: Vec<f64>,
