@@ -169,7 +169,7 @@ pub struct MoveReport {
     pub trades: Vec<Trade>,
 }
 
-/// Two or three bodies each seated on the next one's place (see [`MoveReport::trades`]).
+/// Bodies seated on each other's places (see [`MoveReport::trades`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Trade {
     pub launch: Vec<f64>,

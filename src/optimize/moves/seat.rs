@@ -1,7 +1,7 @@
 //! Seat: place and pose a body from scratch. [`Seat`] scans every pose of a mesh (and
 //! of a block where the caller asks) on its own place, of two meshes of one kind each
 //! on the other's, of a hidden block and another on the two halves of that one's part,
-//! and, in a call that trades, of two or three bodies each on the next one's place;
+//! and, in a call that trades, of bodies moved onto each other's places;
 //! the best are refined ([`Seats`]) and launched there. [`PoseFit`] fits every block
 //! to the picture on its pose at `t` (turns, shifts and depth) and launches it there.
 
@@ -83,25 +83,25 @@ impl Move for Seat {
                 }
             }
         }
-        // ... and, when the caller asks, bodies of one kind and different shapes each on
-        // the next one's place: the cycles the table of seats ranks best, refined.
+        // ... and, when the caller asks, bodies of one kind and different shapes moved
+        // onto each other's places: the trades the table of seats ranks best, refined.
         let shape = |i: usize| &problem.scene.occluders[i].shape;
         for group in r.trades {
             let of_meshes = matches!(shape(group[0]), Shape::Mesh(_));
-            let (cap, slack) = if of_meshes {
-                (seats::MESH_TRADES, TRADE_SLACK)
+            let (cap, longest, slack) = if of_meshes {
+                (seats::MESH_TRADES, group.len(), TRADE_SLACK)
             } else {
-                (seats::TRADES, 1)
+                (seats::TRADES, seats::BLOCK_CYCLE, 1)
             };
             let first = out.list.len();
-            let cycles = seats.trade_scan(group, cap, out.ws);
-            let found = seats::each(problem, &cycles, out.ws, |cycle, ws| {
-                seats.many(cycle, SEAT_KEPT, ws)
+            let trades = seats.trade_scan(group, (cap, longest), out.ws);
+            let found = seats::each(problem, &trades, out.ws, |trade, ws| {
+                seats.many(trade, SEAT_KEPT, ws)
             });
-            for (cycle, found) in cycles.iter().zip(found) {
+            for (trade, found) in trades.iter().zip(found) {
                 if let Some((_, poses)) = found.filter(|f| f.0 < slack * r.wrong) {
                     let seated: Vec<(usize, (DVec3, DQuat))> =
-                        cycle.iter().map(|c| c.0).zip(poses).collect();
+                        trade.iter().map(|c| c.0).zip(poses).collect();
                     seat(r, &seated, out);
                 }
             }

@@ -120,22 +120,22 @@ impl Seats<'_> {
         Some((cost, poses))
     }
 
-    /// Trades of places among `bodies` (of one kind) worth refining, best first, at most
-    /// `cap`: each two or three bodies of different shapes, each to be seated on
-    /// the place of the next (the last on the first's), as `(body, place)`.
+    /// Trades of places among `blocks` (of one kind) worth refining, best first, at most
+    /// `cap`: each a cycle of two to `longest` bodies of different shapes, each to be
+    /// seated on the place of the next (the last on the first's), as `(body, place)`.
     ///
     /// Each body is seated ([`seat_pose`], its scan's best pose refined) on the place of
     /// every body of another shape, over the picture without the two, once; that seat's
     /// change of the picture's wrong pixels, added over a cycle to what taking its
     /// bodies out costs the picture, ranks the cycle. A table of one seat per ordered
-    /// pair (`n (n - 1)` at most) ranks every pair and three-cycle, where seating each
-    /// cycle alone would cost three seats for each of `n (n - 1) (n - 2) / 3`
-    /// three-cycles. (The scan alone ranks blocks as well, but not pieces: a chess
-    /// piece's scanned shadow is off by hundreds of pixels, more than a trade gains.)
+    /// pair (`n (n - 1)` at most) ranks every cycle ([`cycles`]), where seating each
+    /// cycle alone would cost a seat per body of every one. (The scan alone ranks blocks
+    /// as well, but not pieces: a chess piece's scanned shadow is off by hundreds of
+    /// pixels, more than a trade gains.)
     pub(super) fn trade_scan(
         &self,
         blocks: &[usize],
-        cap: usize,
+        (cap, longest): (usize, usize),
         ws: &mut Workspace,
     ) -> Vec<Vec<(usize, Place)>> {
         let target = &self.problem.target.mask;
@@ -163,8 +163,9 @@ impl Seats<'_> {
         for (&(a, b, _), change) in pairs.iter().zip(seated) {
             on[a][b] = change;
         }
-        let mut cycles: Vec<(i64, Vec<usize>)> = Vec::new();
-        let mut consider = |cycle: &[usize]| {
+        let mut trades: Vec<(i64, Vec<usize>)> = Vec::new();
+        let linked = |a: usize, b: usize| on[a][b].is_some();
+        cycles(n, longest, &linked, &mut |cycle| {
             let mut change = 0;
             for (k, &a) in cycle.iter().enumerate() {
                 let Some(seated) = on[a][cycle[(k + 1) % cycle.len()]] else {
@@ -172,22 +173,10 @@ impl Seats<'_> {
                 };
                 change += out[a] + seated;
             }
-            cycles.push((change, cycle.to_vec()));
-        };
-        // Each cycle once: its first block the lowest index; a pair has one direction,
-        // three blocks two.
-        for a in 0..n {
-            for b in a + 1..n {
-                consider(&[a, b]);
-                for c in a + 1..n {
-                    if c != b {
-                        consider(&[a, b, c]);
-                    }
-                }
-            }
-        }
-        cycles.sort_by_key(|c| c.0);
-        cycles
+            trades.push((change, cycle.to_vec()));
+        });
+        trades.sort_by_key(|c| c.0);
+        trades
             .into_iter()
             .take(cap)
             .filter_map(|(_, cycle)| {
@@ -315,6 +304,46 @@ impl Seats<'_> {
     }
 }
 
+/// Every cycle of two to `longest` distinct indices below `n`, its first the lowest,
+/// each step `a -> b` one that `linked` allows, passed to `visit` as a path (the cycle
+/// closes from its last back to its first, which `visit` judges): depth first, so
+/// that `[a, b]` comes before the longer cycles that start with it, and a cycle of
+/// three comes right after the pair it extends (the order of a table of pairs and
+/// three-cycles).
+fn cycles(
+    n: usize,
+    longest: usize,
+    linked: &dyn Fn(usize, usize) -> bool,
+    visit: &mut dyn FnMut(&[usize]),
+) {
+    fn grow(
+        path: &mut Vec<usize>,
+        n: usize,
+        longest: usize,
+        linked: &dyn Fn(usize, usize) -> bool,
+        visit: &mut dyn FnMut(&[usize]),
+    ) {
+        let last = path[path.len() - 1];
+        for next in path[0] + 1..n {
+            if path.contains(&next) || !linked(last, next) {
+                continue;
+            }
+            path.push(next);
+            visit(path);
+            if path.len() < longest {
+                grow(path, n, longest, linked, visit);
+            }
+            path.pop();
+        }
+    }
+    let mut path = Vec::with_capacity(longest);
+    for first in 0..n {
+        path.clear();
+        path.push(first);
+        grow(&mut path, n, longest, linked, visit);
+    }
+}
+
 /// `part` cut across its long axis (of its second moments) at each fraction of its
 /// pixels in `cuts`, counted along that axis: the centroid (pixels) and area (pixels) of
 /// the side below the cut and of the side above, for each cut whose sides both hold
@@ -380,8 +409,8 @@ const SPLIT_LEAST: f64 = 16.0;
 pub(super) const SPLITS: usize = 4;
 
 /// Trades of blocks that [`improve`](super::improve) refines ([`Seats::trade_scan`]),
-/// those ranked best by the scans. The table ranks a trade by seats made one at a time
-/// over the picture without their two blocks, so a trade whose seats share a cluster of
+/// those ranked best by the table of seats. The table ranks a trade by seats made one
+/// at a time over the picture without their two blocks, so a trade whose seats share a cluster of
 /// overlapping shadows is ranked off: on the planted boxes 11504 the trade that mends
 /// it (a long block end-on in a cluster, a short one stretched over a long block's
 /// part) is the fifth, and on boxes12 11505 it lies beyond the twelfth. Refining the best
@@ -393,13 +422,52 @@ pub(super) const TRADES: usize = 30;
 
 /// Trades of meshes that [`improve`](super::improve) refines and reports
 /// ([`MoveReport::trades`](super::MoveReport::trades)): the table's ranks say little of
-/// them (a piece's scanned shadow is off by hundreds of pixels), so most of the table
-/// (six pieces make 15 pairs and 40 three-cycles at most).
+/// them (a piece's scanned shadow is off by hundreds of pixels), so many of its trades
+/// (six pieces of six shapes make 409 cycles, 15 pairs and 40 three-cycles of them).
 pub(super) const MESH_TRADES: usize = 40;
+
+/// The blocks in a trade at most: pairs and cycles of three. Blocks come by the dozen
+/// (twelve of three sizes make 176 such trades, 968 with cycles of four and 18,824 up to
+/// six), the table ranks a trade by adding one estimate per block, and a trade of
+/// blocks is judged as seated, without the runs that search a trade of meshes. The
+/// meshes, six at most ([`MAX_MESH_TRADES`](super::sight::MAX_MESH_TRADES)), trade in
+/// cycles of any length.
+pub(super) const BLOCK_CYCLE: usize = 3;
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cycles_come_each_once_from_their_lowest_and_after_the_pair_they_extend() {
+        let all = |n, longest, linked: &dyn Fn(usize, usize) -> bool| {
+            let mut seen: Vec<Vec<usize>> = Vec::new();
+            cycles(n, longest, linked, &mut |c| seen.push(c.to_vec()));
+            seen
+        };
+        let any = |_: usize, _: usize| true;
+        // Six of six shapes: 15 pairs, 40 cycles of three, 90 of four, 144 of five, 120
+        // of six; up to three, in the order of a table of pairs and three-cycles.
+        assert_eq!(all(6, 6, &any).len(), 409);
+        let short = all(6, 3, &any);
+        let mut table = Vec::new();
+        for a in 0..6 {
+            for b in a + 1..6 {
+                table.push(vec![a, b]);
+                for c in (a + 1..6).filter(|&c| c != b) {
+                    table.push(vec![a, b, c]);
+                }
+            }
+        }
+        assert_eq!(short, table);
+        // No step that `linked` forbids: two kinds alternate.
+        let alternate = |a: usize, b: usize| a % 2 != b % 2;
+        let found = all(6, 6, &alternate);
+        assert!(found
+            .iter()
+            .all(|c| c.windows(2).all(|w| w[0] % 2 != w[1] % 2)));
+        assert_eq!(found.iter().filter(|c| c.len() == 2).count(), 9);
+    }
 
     #[test]
     fn a_part_is_cut_across_its_long_axis_at_fractions_of_its_pixels() {

@@ -164,8 +164,7 @@ pub const TRADE_IOU: Threshold = Threshold {
     name: "trade_iou",
     value: 0.985,
     unit: "IoU",
-    why: "two or three bodies each on the next one's part is a state no move of one or two \
-          bodies mends; trades cost 1.25 times the solve time of planted block and chess \
+    why: "bodies each on another's part is a state no move of one or two bodies mends; trades cost 1.25 times the solve time of planted block and chess \
           problems, paid only where the picture is poor",
 };
 
