@@ -410,10 +410,10 @@ pub(super) const SPLITS: usize = 4;
 
 /// Trades of blocks that [`improve`](super::improve) refines ([`Seats::trade_scan`]),
 /// those ranked best by the table of seats. The table ranks a trade by seats made one
-/// at a time over the picture without their two blocks, so a trade whose seats share a cluster of
-/// overlapping shadows is ranked off: on the planted boxes 11504 the trade that mends
-/// it (a long block end-on in a cluster, a short one stretched over a long block's
-/// part) is the fifth, and on boxes12 11505 it lies beyond the twelfth. Refining the best
+/// at a time over the picture without their two blocks, so a trade whose seats share a
+/// cluster of overlapping shadows is ranked off: on the planted boxes 11504 the trade
+/// that mends it (a long block end-on in a cluster, a short one stretched over a long
+/// block's part) is the fifth, and on boxes12 11505 it lies beyond the twelfth. Refining the best
 /// 30 raised those two from 0.9631 and 0.9698 to 0.9733 and 0.9833 (and boxes12 11405
 /// from 0.9629 to 0.9693) and changed none of the other 39 problems with blocks of the
 /// draws 11400 and 11500 (`git show c030f18:docs/results.md`, "More trades of blocks refined"); 80 found
