@@ -6,7 +6,9 @@ table, from the `passes` of every `solution.json` under the folders given:
 
 (the ROOT folders of scripts/planted-suite.sh or scripts/new-suite.sh). A pass "paid"
 where it raised its stage's IoU by 0.001 or more; "in the kept attempt" counts those of
-the attempt whose picture the solve kept. Passes of the last stage are listed apart."""
+the attempt whose picture the solve kept. Passes of the last stage are listed apart.
+A second table lists the moves the passes took (each pass's `moves`), by the pass that
+took them (`moves`, `runs` before a restart, `trades`, `polish`) and the move's name."""
 import collections
 import glob
 import json
@@ -15,6 +17,7 @@ import sys
 MIN_GAIN = 0.001
 rows = collections.defaultdict(lambda: {"samples": 0, "time": 0.0, "gain": 0.0, "ran": 0,
                                         "paid": 0, "kept": 0})
+moves = collections.defaultdict(lambda: {"taken": 0, "paid": 0, "gain": 0.0, "solves": set()})
 solutions = 0
 for root in sys.argv[1:]:
     for path in sorted(glob.glob(f"{root}/**/solution.json", recursive=True)):
@@ -34,6 +37,13 @@ for root in sys.argv[1:]:
             r["ran"] += 1
             r["paid"] += gain >= MIN_GAIN
             r["kept"] += gain >= MIN_GAIN and p["attempt"] == kept
+            for m in p.get("moves") or []:
+                gain = m["iou_after"] - m["iou_before"]
+                r = moves[(p["pass"], m["move"])]
+                r["taken"] += 1
+                r["paid"] += gain >= MIN_GAIN
+                r["gain"] += gain
+                r["solves"].add(path)
 if not solutions:
     sys.exit("no solution.json with passes under " + " ".join(sys.argv[1:]))
 samples = sum(r["samples"] for r in rows.values())
@@ -44,3 +54,10 @@ print("|---|---|---|---|---|---|---|")
 for name, r in sorted(rows.items(), key=lambda kv: -kv[1]["time"]):
     print(f"| {name} | {100 * r['samples'] / samples:.1f} % | {100 * r['time'] / time:.1f} % | "
           f"{r['ran']} | {r['paid']} | {r['kept']} | {r['gain']:.3f} |")
+
+if moves:
+    print("\n| pass | move | taken | paid (IoU +0.001 or more) | in solves | IoU gained, summed |")
+    print("|---|---|---|---|---|---|")
+    for (pass_, name), r in sorted(moves.items(), key=lambda kv: -kv[1]["gain"]):
+        print(f"| {pass_} | {name} | {r['taken']} | {r['paid']} | {len(r['solves'])} | "
+              f"{r['gain']:.3f} |")

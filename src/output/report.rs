@@ -301,7 +301,7 @@ fn passes_html(h: &mut String, s: &Solution) {
     }
     h.push_str(
         "<h2>Passes</h2>\n<table><tr><th>pass</th><th>ran</th><th>samples</th>\
-         <th>wall time (s)</th><th>IoU gained</th></tr>\n",
+         <th>wall time (s)</th><th>IoU gained</th><th>moves taken</th></tr>\n",
     );
     let mut kinds: Vec<&str> = Vec::new();
     for p in &s.passes {
@@ -311,14 +311,24 @@ fn passes_html(h: &mut String, s: &Solution) {
     }
     for kind in kinds {
         let of: Vec<_> = s.passes.iter().filter(|p| p.pass == kind).collect();
+        // The moves taken, by name in the order first taken: "pose fit 9, seat 2".
+        let mut taken: Vec<(&str, usize)> = Vec::new();
+        for m in of.iter().flat_map(|p| &p.moves) {
+            match taken.iter_mut().find(|t| t.0 == m.name) {
+                Some(t) => t.1 += 1,
+                None => taken.push((&m.name, 1)),
+            }
+        }
+        let taken: Vec<String> = taken.iter().map(|(n, c)| format!("{n} {c}")).collect();
         let _ = writeln!(
             h,
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.2}</td><td>{:+.4}</td></tr>",
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.2}</td><td>{:+.4}</td><td>{}</td></tr>",
             esc(kind),
             of.len(),
             of.iter().map(|p| p.samples).sum::<usize>(),
             of.iter().map(|p| p.wall_time_s).sum::<f64>(),
             of.iter().map(|p| p.iou_after - p.iou_before).sum::<f64>(),
+            esc(&taken.join(", ")),
         );
     }
     h.push_str(
@@ -388,7 +398,10 @@ mod tests {
                 "wall_time_s": 0.1}],
             "passes": [
                 {"attempt": 0, "stage": 0, "pass": "moves", "iou_before": 0.5,
-                 "iou_after": 0.6, "samples": 4, "wall_time_s": 0.01},
+                 "iou_after": 0.6, "samples": 4, "wall_time_s": 0.01,
+                 "moves": [{"move": "seat", "iou_before": 0.5, "iou_after": 0.55},
+                           {"move": "fill", "iou_before": 0.55, "iou_after": 0.58},
+                           {"move": "seat", "iou_before": 0.58, "iou_after": 0.6}]},
                 {"attempt": 0, "stage": 0, "pass": "runs", "iou_before": 0.6,
                  "iou_after": 0.99, "samples": 6, "wall_time_s": 0.09}]
         });
@@ -414,7 +427,13 @@ mod tests {
         assert!(d0 < xor);
         assert!(page.contains("No contact before t"));
         // Every pass that ran, and a line per kind with the IoU it gained.
-        assert!(page.contains("<td>runs</td><td>1</td><td>6</td><td>0.09</td><td>+0.3900</td>"));
+        assert!(page
+            .contains("<td>runs</td><td>1</td><td>6</td><td>0.09</td><td>+0.3900</td><td></td>"));
+        // The moves a kind of pass took, counted by name in the order first taken.
+        assert!(
+            page.contains("<td>+0.1000</td><td>seat 2, fill 1</td>"),
+            "{page}"
+        );
         assert!(page.contains("<td>1 fine</td><td>moves</td><td>0.5000</td><td>0.6000</td>"));
         assert!(!page.contains("Error budget"));
         std::fs::write(

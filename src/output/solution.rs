@@ -164,6 +164,19 @@ pub struct PassRecord {
     pub iou_after: f64,
     pub samples: usize,
     pub wall_time_s: f64,
+    /// The moves the pass took, in order (a pass of moves, trades or polish).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub moves: Vec<MoveRecord>,
+}
+
+/// A move a pass took (see `optimize::moves`): `swap`, `fill`, `fit`, `reorient`,
+/// `seat`, `seat pair`, `split`, `trade` or `pose fit`, and the IoU before and after it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MoveRecord {
+    #[serde(rename = "move")]
+    pub name: String,
+    pub iou_before: f64,
+    pub iou_after: f64,
 }
 
 /// One attempt of a solve (its stages from the start guess, with its own seed).

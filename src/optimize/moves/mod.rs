@@ -52,6 +52,9 @@ use crate::sim::flight::FreeFlight;
 
 /// A move: offers candidates from the launch kept.
 trait Move: Sync {
+    /// What a pass's record calls the moves of this kind that it took
+    /// ([`MoveReport::taken`]).
+    fn name(&self) -> &'static str;
     /// Evaluate this move's candidates from the round's launch into `out`.
     fn offer(&self, round: &Round, out: &mut Offers);
 }
@@ -100,6 +103,8 @@ struct Offers<'s, 'a> {
     exchanges: Vec<Exchange>,
     /// The offers that are trades of meshes.
     mesh_trades: Range<usize>,
+    /// The name the offers get: the move's, or the kind of its offers it now makes.
+    name: &'static str,
 }
 
 impl<'s, 'a> Offers<'s, 'a> {
@@ -117,6 +122,7 @@ impl<'s, 'a> Offers<'s, 'a> {
             list: Vec::new(),
             exchanges: Vec::new(),
             mesh_trades: 0..0,
+            name: "",
         }
     }
 
@@ -127,6 +133,7 @@ impl<'s, 'a> Offers<'s, 'a> {
             launch: self.candidate.clone(),
             bodies: bodies.to_vec(),
             eval,
+            name: self.name,
         });
     }
 
@@ -137,6 +144,7 @@ impl<'s, 'a> Offers<'s, 'a> {
             launch: launch.to_vec(),
             bodies: bodies.to_vec(),
             eval,
+            name: self.name,
         });
     }
 }
@@ -144,8 +152,8 @@ impl<'s, 'a> Offers<'s, 'a> {
 /// What one call of [`improve`] did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MoveReport {
-    /// Moves taken.
-    pub accepted: usize,
+    /// The moves taken, in order.
+    pub taken: Vec<Taken>,
     /// Samples evaluated.
     pub samples: usize,
     /// The launch of the candidate with the lowest energy of all, when it has a contact
@@ -167,6 +175,15 @@ pub struct MoveReport {
     /// until the pieces around have moved to make room, which a local search of the
     /// traded pieces may do (the caller's). Empty when the last pass took a move.
     pub trades: Vec<Trade>,
+}
+
+/// A move taken: its name (its [`Move`]'s, or the kind of that move's offers) and the
+/// IoU before and after it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Taken {
+    pub name: &'static str,
+    pub iou_before: f64,
+    pub iou_after: f64,
 }
 
 /// Bodies seated on each other's places (see [`MoveReport::trades`]).
@@ -274,6 +291,7 @@ struct Offer {
     launch: Vec<f64>,
     bodies: Vec<usize>,
     eval: Evaluation,
+    name: &'static str,
 }
 
 /// How far [`improve`] goes, from what, and what for.
@@ -428,8 +446,12 @@ pub fn improve(
             Some(offer) => {
                 let e = offer.eval;
                 params.copy_from_slice(&offer.launch);
+                report.taken.push(Taken {
+                    name: offer.name,
+                    iou_before: current.iou,
+                    iou_after: e.iou,
+                });
                 *best = e;
-                report.accepted += 1;
                 // Exchanges and trades of the launch before this move are stale.
                 exchanges.clear();
                 trade_offers.clear();
@@ -636,6 +658,7 @@ fn offer_all<'a>(
         mesh_trades: 0..0,
     };
     for part in beside(pool, search, MOVES.to_vec(), scratch, |m, out| {
+        out.name = m.name();
         m.offer(round, out)
     }) {
         if !part.mesh_trades.is_empty() {

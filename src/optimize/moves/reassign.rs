@@ -19,6 +19,10 @@ use crate::shadow::mask::Mask;
 pub(super) struct Swap;
 
 impl Move for Swap {
+    fn name(&self) -> &'static str {
+        "swap"
+    }
+
     fn offer(&self, r: &Round, out: &mut Offers) {
         let (problem, params) = (r.problem, r.params);
         for (a, &i) in r.movable.iter().enumerate() {
@@ -80,6 +84,10 @@ impl Move for Swap {
 pub(super) struct Fill;
 
 impl Move for Fill {
+    fn name(&self) -> &'static str {
+        "fill"
+    }
+
     fn offer(&self, r: &Round, out: &mut Offers) {
         let Some((area, centroid, (x0, y0))) = r.hole else {
             return;

@@ -26,6 +26,10 @@ const TURNS: [f64; 3] = [
 pub(super) struct Reorient;
 
 impl Move for Reorient {
+    fn name(&self) -> &'static str {
+        "reorient"
+    }
+
     fn offer(&self, r: &Round, out: &mut Offers) {
         let (problem, params) = (r.problem, r.params);
         let scene = &problem.scene;

@@ -23,6 +23,10 @@ use crate::scene::Launch;
 pub(super) struct Seat;
 
 impl Move for Seat {
+    fn name(&self) -> &'static str {
+        "seat"
+    }
+
     fn offer(&self, r: &Round, out: &mut Offers) {
         let purpose = r.options.purpose;
         if !(r.first || purpose.trades() || purpose.seats_blocks()) {
@@ -50,6 +54,7 @@ impl Move for Seat {
         }
         // ... and two of a kind each on the other's: every pair scanned, the best
         // refined.
+        out.name = "seat pair";
         let pairs: Vec<(usize, usize)> = r
             .meshes
             .iter()
@@ -75,6 +80,7 @@ impl Move for Seat {
         }
         // ... and a hidden block seated beside another on that one's part, cut in two:
         // every cut scanned, the best refined.
+        out.name = "split";
         for (h, j, [place_h, place_j]) in seats.split_scan(r.blocks, &r.bare, out.ws) {
             let two = seats.two((h, place_h), (j, place_j), SEAT_KEPT, out.ws);
             if let Some((cost, [ph, pj])) = two {
@@ -85,6 +91,7 @@ impl Move for Seat {
         }
         // ... and, when the caller asks, bodies of one kind and different shapes moved
         // onto each other's places: the trades the table of seats ranks best, refined.
+        out.name = "trade";
         let shape = |i: usize| &problem.scene.occluders[i].shape;
         for group in r.trades {
             let of_meshes = matches!(shape(group[0]), Shape::Mesh(_));
@@ -140,6 +147,10 @@ fn seat(r: &Round, seated: &[(usize, (DVec3, DQuat))], out: &mut Offers) {
 pub(super) struct PoseFit;
 
 impl Move for PoseFit {
+    fn name(&self) -> &'static str {
+        "pose fit"
+    }
+
     fn offer(&self, r: &Round, out: &mut Offers) {
         out.candidate.copy_from_slice(r.params);
         out.ws.poses.copy_from_slice(&r.current_poses);

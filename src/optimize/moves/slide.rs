@@ -18,6 +18,10 @@ const FIT_TOLERANCE: f64 = 1.5;
 pub(super) struct Fit;
 
 impl Move for Fit {
+    fn name(&self) -> &'static str {
+        "fit"
+    }
+
     fn offer(&self, r: &Round, out: &mut Offers) {
         for &i in r.movable {
             let Some(si) = r.sights[i] else { continue };

@@ -153,7 +153,7 @@ pub(super) fn polish(
     seed: u64,
     ws: &mut Workspace,
     record: &mut dyn FnMut(&Evaluation),
-) -> (usize, usize, usize) {
+) -> (usize, Vec<moves::Taken>, usize) {
     let contacts = problem.scene.contacts;
     let (mut samples, seated) =
         polish_moves(problem, pool, held, stage, (params, best), ws, record);
@@ -200,7 +200,7 @@ fn polish_moves(
     (params, best): (&mut [f64], &mut Evaluation),
     ws: &mut Workspace,
     record: &mut dyn FnMut(&Evaluation),
-) -> (usize, usize) {
+) -> (usize, Vec<moves::Taken>) {
     let contacts = problem.scene.contacts;
     let rank = |e: &Evaluation| rank_value(e, contacts);
     let (kept, kept_eval) = (params.to_vec(), *best);
@@ -221,11 +221,11 @@ fn polish_moves(
         ws,
         record,
     );
-    let (samples, mut seated) = (seats.samples, seats.accepted);
+    let (samples, mut seated) = (seats.samples, seats.taken);
     if best.iou < kept_eval.iou {
         params.copy_from_slice(&kept);
         *best = kept_eval;
-        seated = 0;
+        seated.clear();
     }
     (samples, seated)
 }

@@ -21,7 +21,7 @@ use crate::energy::{Term, Weights};
 use crate::evaluate::{Evaluation, Held, Problem, Workspace};
 use crate::optimize::cmaes::{Cmaes, CmaesConfig, StopReason};
 use crate::optimize::moves::{self, MoveOptions, MoveReport, Purpose};
-use crate::output::solution::{PassRecord, SampleRecord};
+use crate::output::solution::{MoveRecord, PassRecord, SampleRecord};
 use crate::scene::Stage;
 use crate::shadow::mask::Mask;
 
@@ -89,6 +89,8 @@ pub(super) struct StageRun<'a> {
     run_start: Evaluation,
     /// The last round of moves before a run, and whether it traded.
     moved: Option<(MoveReport, Purpose)>,
+    /// The moves taken since the last pass's record.
+    taken: Vec<MoveRecord>,
     polish: Option<String>,
 }
 
@@ -151,6 +153,7 @@ impl<'a> StageRun<'a> {
             trade_taken: false,
             run_start: eval,
             moved: None,
+            taken: Vec::new(),
             polish: None,
         }
     }
@@ -176,6 +179,7 @@ impl<'a> StageRun<'a> {
                     iou_after: self.eval.iou,
                     samples: self.samples - samples,
                     wall_time_s: clock.elapsed().as_secs_f64(),
+                    moves: std::mem::take(&mut self.taken),
                 });
             }
         }
@@ -263,9 +267,10 @@ impl<'a> StageRun<'a> {
             &mut |e: &Evaluation| records.push(sample_record(k, iteration, &weights, e)),
         );
         self.samples += moved.samples;
-        if moved.accepted > 0 {
+        if !moved.taken.is_empty() {
             self.mask.copy_from(&self.ws.mask);
         }
+        self.taken.extend(moved.taken.iter().map(move_record));
         self.moved = Some((moved, purpose));
     }
 
@@ -309,11 +314,11 @@ impl<'a> StageRun<'a> {
             let start_from = match self.moved.take() {
                 Some((moved, purpose)) => moved
                     .promising
-                    .filter(|_| moved.accepted == 0 || purpose == Purpose::Trade),
+                    .filter(|_| moved.taken.is_empty() || purpose == Purpose::Trade),
                 None => {
                     self.moves();
                     let (moved, _) = self.moved.take().expect("the moves just ran");
-                    moved.promising.filter(|_| moved.accepted == 0)
+                    moved.promising.filter(|_| moved.taken.is_empty())
                 }
             };
             self.stop = self.cmaes(start_from);
@@ -457,7 +462,7 @@ impl<'a> StageRun<'a> {
         self.rejudge(&self.weights());
         self.round_of_moves(TRADE_MOVES.value as usize, Purpose::Trade);
         let (moved, _) = self.moved.as_ref().expect("the moves just ran");
-        if moved.accepted > 0 {
+        if !moved.taken.is_empty() {
             self.run_start = run_start;
             return self.runs();
         }
@@ -508,7 +513,7 @@ impl<'a> StageRun<'a> {
         self.rejudge(&unhinted);
         let (k, iteration, weights) = (self.k, self.iteration, self.given.weights);
         let records = &mut *self.records;
-        let (used, seated, moved) = polish(
+        let (used, taken, moved) = polish(
             self.problem,
             self.pool,
             &self.held,
@@ -520,6 +525,8 @@ impl<'a> StageRun<'a> {
             &mut |e: &Evaluation| records.push(sample_record(k, iteration, &weights, e)),
         );
         self.samples += used;
+        let seated = taken.len();
+        self.taken.extend(taken.iter().map(move_record));
         let ran = if self.trade_taken {
             self.unhinted.weights
         } else {
@@ -559,6 +566,15 @@ impl<'a> StageRun<'a> {
             polish: self.polish,
             kept_start,
         }
+    }
+}
+
+/// The record of a move taken.
+fn move_record(m: &moves::Taken) -> MoveRecord {
+    MoveRecord {
+        name: m.name.to_string(),
+        iou_before: m.iou_before,
+        iou_after: m.iou_after,
     }
 }
 
