@@ -8,7 +8,7 @@
 //! family a file, are what `docs/solver.md` tabulates:
 //! - [`reassign`]: send bodies to other parts ([`Swap`], with the exchanges of pose
 //!   and place that the solver refines; [`Fill`] the largest bare part);
-//! - [`reorient`]: search a body's pose where it is ([`Reorient`]: turns, align, lay);
+//! - [`reorient`]: search a mesh's pose where it is ([`Reorient`]: turns, align, lay);
 //! - [`seat`]: place and pose a body from scratch ([`Seat`]: seats on its own place, on
 //!   another's, on half of a part, and the trades of places; [`PoseFit`] of blocks);
 //! - [`slide`]: depth and size ([`Fit`], and the slides of [`Search::polish`]).
