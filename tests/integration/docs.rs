@@ -1,6 +1,6 @@
 //! The reference made from the clap definitions: `docs/cli.md` equal to the help it is
-//! generated from, `bsa completions` and `bsa man`, `bsa new --help` naming every
-//! object form of the README, and `docs/solver.md` naming tests that exist.
+//! generated from, `bsa completions` and `bsa man`, and `bsa new --help` naming every
+//! object form of the README.
 
 use std::process::Command;
 
@@ -147,47 +147,6 @@ fn new_help_names_every_object_form() {
         assert!(
             help.contains(form),
             "`bsa new --help` does not name {form}:\n{help}"
-        );
-    }
-}
-
-/// Every test that `docs/solver.md`'s table names (its last column) is a test of the
-/// crate: a `#[test]` function of that name under `tests/` or `src/`.
-#[test]
-fn docs_solver_md_names_tests_that_exist() {
-    let page = std::fs::read_to_string(root().join("docs/solver.md")).unwrap();
-    let mut sources = String::new();
-    let mut dirs = vec![root().join("tests"), root().join("src")];
-    while let Some(dir) = dirs.pop() {
-        for entry in std::fs::read_dir(&dir).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                dirs.push(path);
-            } else if path.extension().is_some_and(|e| e == "rs") {
-                sources.push_str(&std::fs::read_to_string(&path).unwrap());
-            }
-        }
-    }
-    // The rows of the table whose last column is "the test that shows it".
-    let rows = page
-        .lines()
-        .skip_while(|l| !l.ends_with("| the test that shows it |"))
-        .take_while(|l| l.starts_with('|'))
-        .skip(2);
-    let named: Vec<&str> = rows
-        .filter_map(|row| row.trim_end_matches(" |").rsplit(" | ").next())
-        .flat_map(|cell| cell.split('`').skip(1).step_by(2))
-        .filter(|name| {
-            name.chars()
-                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
-        })
-        .collect();
-    assert!(named.len() >= 10, "{named:?}");
-    for name in named {
-        assert!(
-            sources.contains(&format!("#[test]\nfn {name}()"))
-                || sources.contains(&format!("#[test]\n    fn {name}()")),
-            "docs/solver.md names the test {name}, which no #[test] function is"
         );
     }
 }
