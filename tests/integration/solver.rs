@@ -657,8 +657,8 @@ fn turned_at_t(p: &Problem, planted: &[f64], want: glam::DQuat, guess: glam::DVe
 }
 
 /// The name of the first move a call of the moves took.
-fn first_taken(report: &bsa::optimize::moves::MoveReport) -> Option<&'static str> {
-    report.taken.first().map(|m| m.name)
+fn first_taken(report: &bsa::optimize::moves::MoveReport) -> Option<&str> {
+    report.taken.first().map(|m| m.name.as_str())
 }
 
 /// The moves take a launch under IoU 0.9 back over 0.97, without a contact, the first

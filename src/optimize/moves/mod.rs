@@ -46,6 +46,7 @@ pub use spin::spin_reaching;
 use crate::energy::{Term, Weights, DIVERGED_ENERGY};
 use crate::evaluate::{Evaluation, Held, Problem, Workspace};
 use crate::geometry::shape::Shape;
+use crate::output::solution::MoveRecord;
 use crate::scene::Scene;
 use crate::shadow::mask::Mask;
 use crate::sim::flight::FreeFlight;
@@ -152,8 +153,9 @@ impl<'s, 'a> Offers<'s, 'a> {
 /// What one call of [`improve`] did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MoveReport {
-    /// The moves taken, in order.
-    pub taken: Vec<Taken>,
+    /// The moves taken, in order, each named by its [`Move`] (or the kind of that
+    /// move's offers), as a pass records them.
+    pub taken: Vec<MoveRecord>,
     /// Samples evaluated.
     pub samples: usize,
     /// The launch of the candidate with the lowest energy of all, when it has a contact
@@ -175,15 +177,6 @@ pub struct MoveReport {
     /// until the pieces around have moved to make room, which a local search of the
     /// traded pieces may do (the caller's). Empty when the last pass took a move.
     pub trades: Vec<Trade>,
-}
-
-/// A move taken: its name (its [`Move`]'s, or the kind of that move's offers) and the
-/// IoU before and after it.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Taken {
-    pub name: &'static str,
-    pub iou_before: f64,
-    pub iou_after: f64,
 }
 
 /// Bodies seated on each other's places (see [`MoveReport::trades`]).
@@ -446,8 +439,8 @@ pub fn improve(
             Some(offer) => {
                 let e = offer.eval;
                 params.copy_from_slice(&offer.launch);
-                report.taken.push(Taken {
-                    name: offer.name,
+                report.taken.push(MoveRecord {
+                    name: offer.name.to_string(),
                     iou_before: current.iou,
                     iou_after: e.iou,
                 });

@@ -6,6 +6,7 @@ use super::schedule::{EXCHANGE_RATIO, EXCHANGE_TRIALS, POLISH_STEP_SHARE};
 use super::search::{local_run, rank_value, stage_seed, Pool};
 use crate::evaluate::{Evaluation, Held, Problem, Workspace};
 use crate::optimize::moves;
+use crate::output::solution::MoveRecord;
 use crate::scene::Stage;
 
 /// Refine the best exchanges that `moved` offers (see [`moves::MoveReport::exchanges`])
@@ -153,7 +154,7 @@ pub(super) fn polish(
     seed: u64,
     ws: &mut Workspace,
     record: &mut dyn FnMut(&Evaluation),
-) -> (usize, Vec<moves::Taken>, usize) {
+) -> (usize, Vec<MoveRecord>, usize) {
     let contacts = problem.scene.contacts;
     let (mut samples, seated) =
         polish_moves(problem, pool, held, stage, (params, best), ws, record);
@@ -200,7 +201,7 @@ fn polish_moves(
     (params, best): (&mut [f64], &mut Evaluation),
     ws: &mut Workspace,
     record: &mut dyn FnMut(&Evaluation),
-) -> (usize, Vec<moves::Taken>) {
+) -> (usize, Vec<MoveRecord>) {
     let contacts = problem.scene.contacts;
     let rank = |e: &Evaluation| rank_value(e, contacts);
     let (kept, kept_eval) = (params.to_vec(), *best);

@@ -270,7 +270,7 @@ impl<'a> StageRun<'a> {
         if !moved.taken.is_empty() {
             self.mask.copy_from(&self.ws.mask);
         }
-        self.taken.extend(moved.taken.iter().map(move_record));
+        self.taken.extend_from_slice(&moved.taken);
         self.moved = Some((moved, purpose));
     }
 
@@ -526,7 +526,7 @@ impl<'a> StageRun<'a> {
         );
         self.samples += used;
         let seated = taken.len();
-        self.taken.extend(taken.iter().map(move_record));
+        self.taken.extend(taken);
         let ran = if self.trade_taken {
             self.unhinted.weights
         } else {
@@ -566,15 +566,6 @@ impl<'a> StageRun<'a> {
             polish: self.polish,
             kept_start,
         }
-    }
-}
-
-/// The record of a move taken.
-fn move_record(m: &moves::Taken) -> MoveRecord {
-    MoveRecord {
-        name: m.name.to_string(),
-        iou_before: m.iou_before,
-        iou_after: m.iou_after,
     }
 }
 
