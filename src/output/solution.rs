@@ -158,7 +158,7 @@ pub struct PassRecord {
     pub attempt: usize,
     /// The index of its stage.
     pub stage: usize,
-    /// `moves`, `exchanges`, `runs`, `trades` or `polish`.
+    /// `moves`, `runs`, `trades` or `polish`.
     pub pass: String,
     pub iou_before: f64,
     pub iou_after: f64,

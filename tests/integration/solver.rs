@@ -581,46 +581,6 @@ fn moves_on_two_threads_draw_the_samples_of_one_bit_for_bit() {
     }
 }
 
-#[test]
-fn exchanges_give_two_blocks_each_others_pose_and_place() {
-    // Two blocks of different lengths, planted: IoU 1 with each on its own part.
-    let (p, planted) = planted(
-        "moves-exchange",
-        "box:0.28x0.07x0.035,box:0.14x0.07x0.035",
-        "1.6",
-    );
-    let w = p.scene.stages.last().unwrap().weights;
-    let mut ws = p.workspace();
-    let iou = |params: &[f64], ws: &mut bsa::evaluate::Workspace| p.evaluate(params, &w, ws).iou;
-    assert!(iou(&planted, &mut ws) > 0.9999);
-    // From the planted launch, the exchange puts the long block in the short one's pose
-    // on its part and the other way round: a worse picture, as the two shapes differ.
-    let mut params = planted.clone();
-    let (_, best, report) = run_moves(&p, &mut params, &contact_free_first);
-    assert!(report.taken.is_empty(), "{report:?}");
-    assert!(best.iou > 0.9999);
-    let swapped = report
-        .exchanges
-        .first()
-        .expect("an exchange of the two blocks");
-    assert_eq!(swapped.bodies, [0, 1]);
-    let wrong = iou(&swapped.launch, &mut ws);
-    assert!(wrong < 0.95, "IoU of the exchange {wrong}");
-    // From the wrong pairing, the exchange brings each block back to its own part in
-    // (about) its own pose.
-    let mut params = swapped.launch.clone();
-    let (before, best, report) = run_moves(&p, &mut params, &contact_free_first);
-    let back = report
-        .exchanges
-        .iter()
-        .map(|x| iou(&x.launch, &mut ws))
-        .fold(best.iou, f64::max);
-    assert!(
-        back > before + 0.05 && back > 0.9,
-        "IoU {before} -> {back} ({report:?})"
-    );
-}
-
 /// Two chess pieces of `scenes/thinker/pieces`, planted (IoU 1), and the first piece's
 /// orientation at `t` in the planted launch.
 fn planted_pieces(name: &str, first: &str, second: &str) -> (Problem, Vec<f64>, glam::DQuat) {
@@ -853,8 +813,8 @@ fn last_stage_again(name: &str) -> (f64, u64, String, Vec<String>) {
     let s = crate::util::read_json(&out.join("solution.json"));
     let stages = s["stages"].as_array().unwrap();
     // The record adds up: every sample the last stage counts is a row of convergence.csv
-    // and is drawn by one of its passes (the one-body runs of exchanges, trades and the
-    // polish included).
+    // and is drawn by one of its passes (the one-body runs of trades and the polish
+    // included).
     let last = stages.len() - 1;
     let counted = stages[last]["samples"].as_u64().unwrap();
     let rows = std::fs::read_to_string(out.join("convergence.csv"))

@@ -6,8 +6,8 @@
 //! ([`Search::polish`]) and fits their blocks, and takes the best-ranked when it ranks
 //! better than the launch kept; rounds repeat while one takes a move. The moves, one
 //! family a file, are what `docs/solver.md` tabulates:
-//! - [`reassign`]: send bodies to other parts ([`Swap`], with the exchanges of pose
-//!   and place that the solver refines; [`Fill`] the largest bare part);
+//! - [`reassign`]: send bodies to other parts ([`Swap`], and the exchanges of pose
+//!   and place; [`Fill`] the largest bare part);
 //! - [`reorient`]: search a mesh's pose where it is ([`Reorient`]: turns, align, lay);
 //! - [`seat`]: place and pose a body from scratch ([`Seat`]: seats on its own place, on
 //!   another's, on half of a part, and the trades of places; [`PoseFit`] of blocks);
@@ -101,7 +101,6 @@ struct Offers<'s, 'a> {
     candidate: &'s mut Vec<f64>,
     flight: &'s mut FreeFlight,
     list: Vec<Offer>,
-    exchanges: Vec<Exchange>,
     /// The offers that are trades of meshes.
     mesh_trades: Range<usize>,
     /// The name the offers get: the move's, or the kind of its offers it now makes.
@@ -121,7 +120,6 @@ impl<'s, 'a> Offers<'s, 'a> {
             candidate,
             flight,
             list: Vec::new(),
-            exchanges: Vec::new(),
             mesh_trades: 0..0,
             name: "",
         }
@@ -162,14 +160,6 @@ pub struct MoveReport {
     /// and a lower energy than the launch kept: a better picture that a local search
     /// may free of its contact (the caller may start a run from it).
     pub promising: Option<Vec<f64>>,
-    /// The exchanges of pose and place of two bodies of one kind and different shapes
-    /// (see [`improve`]) from the launch kept, each after [`Search::polish`], best
-    /// picture first: rarely better as they stand (each body is off its new part by a
-    /// little), they are worth a short local search of the two bodies. Empty when the
-    /// last pass took a move.
-    pub exchanges: Vec<Exchange>,
-    /// The energy of the launch kept without the contact term (as [`Exchange::free`]).
-    pub kept_free: f64,
     /// The trades of meshes of the last pass of a call that trades
     /// ([`Purpose::Trade`]), as seated and polished, best picture first, even those
     /// that draw a worse picture than the launch kept (up to [`TRADE_SLACK`] times its
@@ -184,15 +174,6 @@ pub struct MoveReport {
 pub struct Trade {
     pub launch: Vec<f64>,
     pub bodies: Vec<usize>,
-    /// Its energy without the contact term (as [`Exchange::free`]).
-    pub free: f64,
-}
-
-/// Two bodies that took each other's pose and place.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Exchange {
-    pub launch: Vec<f64>,
-    pub bodies: [usize; 2],
     /// Its energy without the contact term.
     pub free: f64,
 }
@@ -380,7 +361,6 @@ pub fn improve(
     }
     let mut search = Search::new(problem, held, weights);
     let mut scratch = Scratch::per_thread(problem, params, pool);
-    let mut exchanges: Vec<Exchange> = Vec::new();
     let mut trade_offers: Vec<Trade> = Vec::new();
     let exchanges_wanted = exchange_pairs(scene, &movable) <= MAX_EXCHANGE_PAIRS;
     let vary: Vec<bool> = (0..scene.occluders.len())
@@ -416,10 +396,8 @@ pub fn improve(
         // Every move of the round, evaluated; the best few are then polished.
         let Offered {
             list: mut offers,
-            exchanges: offered,
             mesh_trades,
         } = offer_all(pool, &round, &mut search, &mut scratch);
-        exchanges = offered;
         trade_offers = offers[mesh_trades]
             .iter()
             .map(|o| search.trade(o))
@@ -445,8 +423,7 @@ pub fn improve(
                     iou_after: e.iou,
                 });
                 *best = e;
-                // Exchanges and trades of the launch before this move are stale.
-                exchanges.clear();
+                // Trades of the launch before this move are stale.
                 trade_offers.clear();
             }
             None => break,
@@ -458,13 +435,10 @@ pub fn improve(
     // Leave the workspace holding the kept launch's flight and shadow.
     *best = problem.evaluate_held(held, params, weights, ws);
     let kept = search.free(best);
-    exchanges.sort_by(|a, b| a.free.total_cmp(&b.free));
     trade_offers.sort_by(|a, b| a.free.total_cmp(&b.free));
     MoveReport {
         samples: search.samples,
-        exchanges,
         trades: trade_offers,
-        kept_free: kept,
         promising: search
             .promising
             .filter(|(energy, _)| *energy < kept)
@@ -638,7 +612,7 @@ impl Scratch {
 }
 
 /// Every move of `round`, evaluated, each beside the others ([`beside`]): their offers
-/// and exchanges in the registry's order, and where the trades of meshes are among them.
+/// in the registry's order, and where the trades of meshes are among them.
 fn offer_all<'a>(
     pool: &rayon::ThreadPool,
     round: &Round,
@@ -647,7 +621,6 @@ fn offer_all<'a>(
 ) -> Offered {
     let mut all = Offered {
         list: Vec::new(),
-        exchanges: Vec::new(),
         mesh_trades: 0..0,
     };
     for part in beside(pool, search, MOVES.to_vec(), scratch, |m, out| {
@@ -659,7 +632,6 @@ fn offer_all<'a>(
             all.mesh_trades = at + part.mesh_trades.start..at + part.mesh_trades.end;
         }
         all.list.extend(part.list);
-        all.exchanges.extend(part.exchanges);
     }
     all
 }
@@ -667,7 +639,6 @@ fn offer_all<'a>(
 /// What a part of a round offered ([`Offers`] without its scratch).
 struct Offered {
     list: Vec<Offer>,
-    exchanges: Vec<Exchange>,
     mesh_trades: Range<usize>,
 }
 
@@ -704,16 +675,9 @@ fn beside<'a, T: Send>(
                         Offers::new(&mut part, &mut s.ws, &mut s.candidate, &mut s.flight);
                     work(item, &mut out);
                     let Offers {
-                        list,
-                        exchanges,
-                        mesh_trades,
-                        ..
+                        list, mesh_trades, ..
                     } = out;
-                    let offered = Offered {
-                        list,
-                        exchanges,
-                        mesh_trades,
-                    };
+                    let offered = Offered { list, mesh_trades };
                     mine.push((k, part, offered));
                 }
                 mine

@@ -2,8 +2,8 @@
 //!
 //! [`Swap`]: two bodies each take the other's part, at the size that part has now,
 //! at the other's place in space, or at the other's whole part; two bodies of one kind
-//! and different shapes each take the other's pose and place too (an exchange, kept
-//! for the solver to refine). [`Fill`]: a body sent to the largest bare part of the
+//! and different shapes each take the other's pose and place too (an exchange).
+//! [`Fill`]: a body sent to the largest bare part of the
 //! target at that part's size, laid along it where it is elongated. The trades of
 //! places among three bodies are seats on each other's places ([`super::seat`]).
 
@@ -11,7 +11,7 @@ use glam::DVec2;
 
 use super::sight::{aim, exchange_poses, exchangeable, lays, long_axis, send, send_to_part};
 use super::spin::turn_spin;
-use super::{Exchange, Move, Offers, Round};
+use super::{Move, Offers, Round};
 use crate::geometry::shape::Shape;
 use crate::shadow::mask::Mask;
 
@@ -53,7 +53,7 @@ impl Move for Swap {
                     out.offer(&[i, j]);
                 }
                 // ... or each takes the other's pose and place (`exchange_poses`),
-                // polished and kept for the caller too.
+                // polished: each body is a little off its new part as it stands.
                 if r.exchanges_wanted && exchangeable(&problem.scene, i, j) {
                     out.candidate.copy_from_slice(params);
                     exchange_poses(
@@ -66,14 +66,8 @@ impl Move for Swap {
                     );
                     let e = out.search.evaluate(out.candidate, out.ws);
                     let mut launch = out.candidate.clone();
-                    let e = out.search.polish(&mut launch, e, &[i, j], out.ws);
+                    out.search.polish(&mut launch, e, &[i, j], out.ws);
                     out.offer_launch(&launch, &[i, j]);
-                    let free = out.search.free(&e);
-                    out.exchanges.push(Exchange {
-                        launch,
-                        bodies: [i, j],
-                        free,
-                    });
                 }
             }
         }

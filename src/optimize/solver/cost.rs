@@ -15,7 +15,7 @@ use crate::output::solution::SampleRecord;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cost {
     /// Samples at most: every run of every stage to its iteration cap, every restart,
-    /// every attempt; the passes that refine (exchanges, trades, polish) add a share.
+    /// every attempt; the passes that refine (trades, polish) add a share.
     pub samples: usize,
     /// Wall time (s): one attempt whose runs stop early (at [`EARLY`] of their caps), and
     /// every attempt to its caps with the moves' time on top ([`MOVES_TIME`]).
@@ -75,7 +75,7 @@ pub fn estimate(problem: &Problem, schedule: &Schedule, threads: usize) -> Cost 
     let refines = schedule
         .stage
         .iter()
-        .any(|s| matches!(s.pass, Pass::Trades | Pass::Polish | Pass::Exchanges))
+        .any(|s| matches!(s.pass, Pass::Trades | Pass::Polish))
         && scene.stages.last().is_some_and(|s| s.vary.len() > 1);
     let (refine_samples, refine_time) = if refines {
         (REFINE_SAMPLES, REFINE_TIME)

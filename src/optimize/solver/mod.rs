@@ -13,8 +13,8 @@
 //! strategy, then the final joint stage) from the best launch of the previous one,
 //! the others held fixed, through the schedule's passes (`stage`): moves, CMA-ES runs
 //! whose populations are evaluated in parallel on a rayon pool with one [`Workspace`]
-//! per thread (`search`), and the one-body refinements of exchanges, trades and the
-//! polish (`refine`).
+//! per thread (`search`), and the one-body refinements of trades and the polish
+//! (`refine`).
 //!
 //! Determinism: candidates come from one seeded RNG per stage in `ask`, and each
 //! sample's energy is a pure function of its launch values, so the result is
@@ -409,7 +409,7 @@ fn attempt(
         }
     }
     // The scene's last stage of one body: the settings of the one-body runs that refine
-    // exchanges, trades and the last stage's polish.
+    // trades and the last stage's polish.
     let one_body = scene.stages.iter().rev().find(|s| s.vary.len() == 1);
     let until = options.until_stage.unwrap_or(usize::MAX);
     for (k, stage) in scene
@@ -439,7 +439,6 @@ fn attempt(
             &mut records,
             &mut passes,
         );
-        run.drawn_before = reports.iter().map(|r| r.samples).sum();
         run.attempt = a;
         run.deadline = deadline;
         let end = run.run(&options.schedule);

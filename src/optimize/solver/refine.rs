@@ -1,84 +1,12 @@
-//! The passes that refine candidates by CMA-ES runs of one body at a time: the
-//! [`exchange`]s and trades ([`trade_trials`]) that the moves offer, and the last
-//! stage's [`polish`].
+//! The passes that refine candidates by CMA-ES runs of one body at a time: the trades
+//! ([`trade_trials`]) that the moves offer, and the last stage's [`polish`].
 
-use super::schedule::{EXCHANGE_RATIO, EXCHANGE_TRIALS, POLISH_STEP_SHARE};
+use super::schedule::POLISH_STEP_SHARE;
 use super::search::{local_run, rank_value, stage_seed, Pool};
 use crate::evaluate::{Evaluation, Held, Problem, Workspace};
 use crate::optimize::moves;
 use crate::output::solution::MoveRecord;
 use crate::scene::Stage;
-
-/// Refine the best exchanges that `moved` offers (see [`moves::MoveReport::exchanges`])
-/// as two rounds of the sequential strategy would: each of the two bodies alone, one
-/// after the other, by a CMA-ES run with the settings of `template` (the scene's last
-/// stage of one body), twice; a trial starts only while its first round fits in `budget`
-/// samples ([`EXCHANGE_SHARE`](super::schedule::EXCHANGE_SHARE)). In the first round the two ignore their contacts with each
-/// other: their new flights often cross (each now flies from its own slot to the
-/// other's part), and a run that must first get out of that contact moves its body off
-/// the picture; the second round counts every contact again. Returns the best refined
-/// launch when it ranks better than `kept` (the launch kept, ranked), and the samples
-/// drawn.
-///
-/// Two pieces of a set that each draw the other's shadow (a king and a bishop lying
-/// down, each at the other's size) are a local optimum that no single move leaves: the
-/// exchange as it stands is a worse picture (each body a few pixels off its new part),
-/// and only its refinement shows whether the other pairing is the better one. A joint
-/// run of the two bodies refined worse than runs of one body each: on the planted chess
-/// problems of seeds 9805 and 9802 it ended above the exchange it started from, where
-/// the rounds of one body took the pictures from 0.965 to 0.986 and from 0.961 to 0.972
-/// (with four trials; under the budget, the first problem's exchange, the third best
-/// picture, is no longer tried).
-#[allow(clippy::too_many_arguments)]
-pub(super) fn exchange(
-    problem: &Problem,
-    pool: &Pool,
-    template: &Stage,
-    moved: &moves::MoveReport,
-    budget: f64,
-    kept: f64,
-    seed: u64,
-    ws: &mut Workspace,
-    record: &mut dyn FnMut(&Evaluation),
-) -> (Option<Vec<f64>>, usize) {
-    let mut best: Option<(f64, Vec<f64>)> = None;
-    let mut samples = 0;
-    let trials = moved
-        .exchanges
-        .iter()
-        .filter(|x| x.free < EXCHANGE_RATIO.value * moved.kept_free)
-        .take(EXCHANGE_TRIALS.value as usize);
-    // A trial's first round: two runs of one body at most.
-    let round = (2 * template.max_iterations * template.population) as f64;
-    for (t, x) in trials.enumerate() {
-        if samples as f64 + round > budget {
-            break;
-        }
-        let mut launch = x.launch.clone();
-        let mut rank = f64::INFINITY;
-        for (g, &body) in x.bodies.iter().cycle().take(4).enumerate() {
-            let run = Stage {
-                vary: vec![body],
-                ..template.clone()
-            };
-            let seed = stage_seed(seed, 4 * t + g);
-            let partner = x.bodies[1 - g % 2];
-            let ignore = (g < 2).then_some(partner);
-            let (l, r, used) = local_run(problem, pool, &run, &launch, ignore, seed, ws, record);
-            (launch, rank) = (l, r);
-            samples += used;
-            // A first round that draws no better picture than the launch kept, even with
-            // the two free to pass through each other, is a wrong pairing.
-            if g == 1 && rank >= kept {
-                break;
-            }
-        }
-        if rank < kept && best.as_ref().is_none_or(|b| rank < b.0) {
-            best = Some((rank, launch));
-        }
-    }
-    (best.map(|b| b.1), samples)
-}
 
 /// The trades of pieces that no call of the moves took as seated (`trades`, best picture
 /// first), each searched by two rounds of one-piece runs of `template` (a stage of one
@@ -113,7 +41,7 @@ pub(super) fn trade_trials(
             };
             let used;
             let seed = stage_seed(seed, 1_000_000 + 16 * t + g);
-            (launch, rank, used) = local_run(problem, pool, &run, &launch, None, seed, ws, record);
+            (launch, rank, used) = local_run(problem, pool, &run, &launch, seed, ws, record);
             samples += used;
         }
         if rank < kept {
@@ -167,7 +95,7 @@ pub(super) fn polish(
             ..template.clone()
         };
         let seed = stage_seed(seed, 2_000_000 + g);
-        let (launch, rank, used) = local_run(problem, pool, &run, params, None, seed, ws, record);
+        let (launch, rank, used) = local_run(problem, pool, &run, params, seed, ws, record);
         samples += used;
         if rank >= rank_value(best, contacts) {
             continue;

@@ -15,9 +15,6 @@ pub enum Pass {
     /// A round of moves ([`crate::optimize::moves::improve`]) from the stage's best:
     /// the global jumps a local search does not make.
     Moves,
-    /// The best exchanges of two bodies' poses and places that the moves offered, each
-    /// refined by two rounds of one-body runs.
-    Exchanges,
     /// Runs of CMA-ES over the stage's bodies: IPOP restarts (twice the population,
     /// the stage's first step) while a run moved the picture, each after a round of
     /// moves.
@@ -36,7 +33,6 @@ impl Pass {
     pub fn name(self) -> &'static str {
         match self {
             Pass::Moves => "moves",
-            Pass::Exchanges => "exchanges",
             Pass::Runs => "runs",
             Pass::Trades => "trades",
             Pass::Polish => "polish",
@@ -51,9 +47,6 @@ impl Pass {
 pub enum When {
     /// In every stage.
     Always,
-    /// In a stage of several bodies, where the scene has a stage of one body whose
-    /// settings the one-body runs take.
-    JointStage,
     /// In the scene's last stage, when its runs ended below `iou` without reaching the
     /// target energy.
     LastStageBelow(Threshold),
@@ -99,7 +92,6 @@ impl Schedule {
     pub const DEFAULT: Schedule = Schedule {
         stage: &[
             step(Pass::Moves, When::Always, Judge::Stage),
-            step(Pass::Exchanges, When::JointStage, Judge::Stage),
             step(Pass::Runs, When::Always, Judge::Stage),
             step(
                 Pass::Trades,
@@ -122,7 +114,6 @@ impl Schedule {
     pub const TRIAL: Schedule = Schedule {
         stage: &[
             step(Pass::Moves, When::Always, Judge::Stage),
-            step(Pass::Exchanges, When::JointStage, Judge::Stage),
             step(Pass::Runs, When::Always, Judge::Stage),
         ],
         attempts: 1,
@@ -177,33 +168,6 @@ pub const TRADE_MOVES: Threshold = Threshold {
           bodies, 13 to 18 % less solve time for the same pictures but one",
 };
 
-/// Exchanges of a joint stage's moves that are refined, at most.
-pub const EXCHANGE_TRIALS: Threshold = Threshold {
-    name: "exchange_trials",
-    value: 4.0,
-    unit: "exchanges",
-    why: "those whose pictures are best as they stand; the mending exchange of the planted \
-          chess problems ranked within the first three",
-};
-
-/// An exchange is refined only when its energy is within this factor of the launch kept.
-pub const EXCHANGE_RATIO: Threshold = Threshold {
-    name: "exchange_ratio",
-    value: 4.0,
-    unit: "x energy kept",
-    why: "an exchange far worse than the launch kept is a wrong pairing, not two bodies a \
-          little off their new parts",
-};
-
-/// The exchanges of a stage draw at most this share of the samples drawn before them.
-pub const EXCHANGE_SHARE: Threshold = Threshold {
-    name: "exchange_share",
-    value: 0.15,
-    unit: "x samples so far",
-    why: "a last resort: on a small solve four trials would cost more than the solve \
-          (22,000 samples in all against 15,000 for the trials)",
-};
-
 /// The step of the polish's one-body runs, a share of the one-body stage's step.
 pub const POLISH_STEP_SHARE: Threshold = Threshold {
     name: "polish_step_share",
@@ -215,15 +179,7 @@ pub const POLISH_STEP_SHARE: Threshold = Threshold {
 
 /// The thresholds of the schedule, as `docs/solver.md` lists them. The moves' own
 /// numbers (depth steps, turns, seat counts) are the moves' and live with them.
-pub const THRESHOLDS: [Threshold; 7] = [
-    ATTEMPTS,
-    TRADE_IOU,
-    TRADE_MOVES,
-    EXCHANGE_TRIALS,
-    EXCHANGE_RATIO,
-    EXCHANGE_SHARE,
-    POLISH_STEP_SHARE,
-];
+pub const THRESHOLDS: [Threshold; 4] = [ATTEMPTS, TRADE_IOU, TRADE_MOVES, POLISH_STEP_SHARE];
 
 #[cfg(test)]
 mod tests {
@@ -257,13 +213,7 @@ mod tests {
     #[test]
     fn docs_name_every_pass_and_tests_that_exist() {
         let tests = include_str!("../../../tests/integration/solver.rs");
-        for pass in [
-            Pass::Moves,
-            Pass::Exchanges,
-            Pass::Runs,
-            Pass::Trades,
-            Pass::Polish,
-        ] {
+        for pass in [Pass::Moves, Pass::Runs, Pass::Trades, Pass::Polish] {
             assert!(
                 SOLVER_MD.contains(&format!("\n| {} ", pass.name())),
                 "{pass:?}"

@@ -1,7 +1,7 @@
 //! The search's machinery below the schedule's passes: the [`Pool`] that evaluates a
 //! population in parallel, the rank CMA-ES sorts by ([`rank_value`]), the seeds of
 //! stages and runs, and one CMA-ES run of a few bodies ([`local_run`]) that the
-//! exchanges, trades and polish refine with.
+//! trades and polish refine with.
 
 use std::sync::Mutex;
 
@@ -202,18 +202,12 @@ pub(super) fn local_run(
     pool: &Pool,
     run: &Stage,
     from: &[f64],
-    ignore: Option<usize>,
     seed: u64,
     ws: &mut Workspace,
     record: &mut dyn FnMut(&Evaluation),
 ) -> (Vec<f64>, f64, usize) {
     let contacts = problem.scene.contacts;
-    let mut held = problem.hold(from, &run.vary).for_stage(run);
-    if let Some(j) = ignore {
-        let mut flags = vec![false; problem.scene.occluders.len()];
-        flags[j] = true;
-        held.ignore_contacts_with(&flags);
-    }
+    let held = problem.hold(from, &run.vary).for_stage(run);
     // The start is a sample like any other: counted, and a row of the record.
     let start = problem.evaluate_held(&held, from, &run.weights, ws);
     record(&start);

@@ -2,16 +2,15 @@
 //! state ([`StageRun`]), each recorded as a [`PassRecord`].
 //!
 //! Data flow: the stage starts from the previous stage's best launch; [`Pass::Moves`]
-//! jumps, [`Pass::Exchanges`] refines the moves' best exchanges, [`Pass::Runs`] runs
-//! CMA-ES (IPOP restarts, each after a round of moves), [`Pass::Trades`] and
+//! jumps, [`Pass::Runs`] runs CMA-ES (IPOP restarts, each after a round of moves), [`Pass::Trades`] and
 //! [`Pass::Polish`] mend what the runs leave in the last stage; the stage never ends
 //! worse than it started (last stage) and reports to the observer.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
-use super::refine::{exchange, polish, trade_trials};
-use super::schedule::{Judge, Pass, Schedule, Step, When, EXCHANGE_SHARE, TRADE_MOVES};
+use super::refine::{polish, trade_trials};
+use super::schedule::{Judge, Pass, Schedule, Step, When, TRADE_MOVES};
 use super::search::{
     best_on_reference, rank_value, restart_seed, run_iterations, run_moved_picture, stage_seed,
     Pool,
@@ -58,8 +57,6 @@ pub(super) struct StageRun<'a> {
     pub last: bool,
     pub robust: bool,
     pub held: Held,
-    /// Samples the attempt drew before this stage.
-    pub drawn_before: usize,
     pub observer: &'a mut dyn Observer,
     pub interrupts: &'a AtomicUsize,
     pub records: &'a mut Vec<SampleRecord>,
@@ -127,7 +124,6 @@ impl<'a> StageRun<'a> {
             last: k + 1 == scene.stages.len(),
             robust: problem.plan.robust.is_some(),
             held,
-            drawn_before: 0,
             observer,
             interrupts,
             records,
@@ -166,7 +162,6 @@ impl<'a> StageRun<'a> {
                 self.judge = step.judge;
                 match step.pass {
                     Pass::Moves => self.moves(),
-                    Pass::Exchanges => self.exchanges(),
                     Pass::Runs => self.runs(),
                     Pass::Trades => self.trades(),
                     Pass::Polish => self.polish(),
@@ -195,7 +190,6 @@ impl<'a> StageRun<'a> {
         searches
             && match step.when {
                 When::Always => true,
-                When::JointStage => self.given.vary.len() > 1 && self.one_body.is_some(),
                 When::LastStageBelow(t) => {
                     self.last
                         && self.stop != Some(StopReason::TargetReached)
@@ -278,31 +272,6 @@ impl<'a> StageRun<'a> {
     fn moves(&mut self) {
         self.run_start = self.eval;
         self.round_of_moves(self.given.vary.len(), Purpose::Stage);
-    }
-
-    /// [`Pass::Exchanges`]: the moves' best exchanges refined (see [`exchange`]).
-    fn exchanges(&mut self) {
-        let (Some(template), Some((moved, _))) = (self.one_body, self.moved.as_ref()) else {
-            return;
-        };
-        let contacts = self.problem.scene.contacts;
-        let (k, iteration, weights) = (self.k, self.iteration, self.weights());
-        let records = &mut *self.records;
-        let (better, used) = exchange(
-            self.problem,
-            self.pool,
-            template,
-            moved,
-            EXCHANGE_SHARE.value * (self.drawn_before + self.samples) as f64,
-            rank_value(&self.eval, contacts),
-            stage_seed(self.seed, k),
-            &mut self.ws,
-            &mut |e: &Evaluation| records.push(sample_record(k, iteration, &weights, e)),
-        );
-        self.samples += used;
-        if let Some(launch) = better {
-            self.take(&launch);
-        }
     }
 
     /// [`Pass::Runs`]: CMA-ES runs from the best, each after the moves before it (the
