@@ -29,8 +29,6 @@ mod sight;
 mod slide;
 mod spin;
 
-use std::ops::Range;
-
 use glam::{DQuat, DVec3};
 
 use pose::{fit_and_launch, fits_pose};
@@ -101,8 +99,6 @@ struct Offers<'s, 'a> {
     candidate: &'s mut Vec<f64>,
     flight: &'s mut FreeFlight,
     list: Vec<Offer>,
-    /// The offers that are trades of meshes.
-    mesh_trades: Range<usize>,
     /// The name the offers get: the move's, or the kind of its offers it now makes.
     name: &'static str,
 }
@@ -120,7 +116,6 @@ impl<'s, 'a> Offers<'s, 'a> {
             candidate,
             flight,
             list: Vec::new(),
-            mesh_trades: 0..0,
             name: "",
         }
     }
@@ -160,30 +155,7 @@ pub struct MoveReport {
     /// and a lower energy than the launch kept: a better picture that a local search
     /// may free of its contact (the caller may start a run from it).
     pub promising: Option<Vec<f64>>,
-    /// The trades of meshes of the last pass of a call that trades
-    /// ([`Purpose::Trade`]), as seated and polished, best picture first, even those
-    /// that draw a worse picture than the launch kept (up to [`TRADE_SLACK`] times its
-    /// wrong pixels): a trade in a cluster of overlapping pieces draws a worse picture
-    /// until the pieces around have moved to make room, which a local search of the
-    /// traded pieces may do (the caller's). Empty when the last pass took a move.
-    pub trades: Vec<Trade>,
 }
-
-/// Bodies seated on each other's places (see [`MoveReport::trades`]).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Trade {
-    pub launch: Vec<f64>,
-    pub bodies: Vec<usize>,
-    /// Its energy without the contact term.
-    pub free: f64,
-}
-
-/// A trade of meshes is offered (and reported, [`MoveReport::trades`]) when its seats
-/// draw fewer than this many times the wrong pixels of the picture kept (blocks: fewer
-/// than the picture kept). The planted chess 10903 (a rook, a bishop and a knight each
-/// on the next one's place in a cluster of four overlapping pieces) is mended by a trade
-/// whose seats draw 1.6 times the energy of the launch kept.
-const TRADE_SLACK: i64 = 4;
 
 /// Moves of a pass polished by [`Search::polish`]: those whose pictures rank first.
 const POLISHED: usize = 4;
@@ -227,15 +199,6 @@ impl<'a> Search<'a> {
             if self.promising.as_ref().is_none_or(|p| energy < p.0) {
                 self.promising = Some((energy, launch));
             }
-        }
-    }
-
-    /// `offer` as a trade the caller may search further.
-    fn trade(&self, offer: &Offer) -> Trade {
-        Trade {
-            launch: offer.launch.clone(),
-            bodies: offer.bodies.clone(),
-            free: self.free(&offer.eval),
         }
     }
 
@@ -361,7 +324,6 @@ pub fn improve(
     }
     let mut search = Search::new(problem, held, weights);
     let mut scratch = Scratch::per_thread(problem, params, pool);
-    let mut trade_offers: Vec<Trade> = Vec::new();
     let exchanges_wanted = exchange_pairs(scene, &movable) <= MAX_EXCHANGE_PAIRS;
     let vary: Vec<bool> = (0..scene.occluders.len())
         .map(|k| movable.contains(&k))
@@ -394,14 +356,7 @@ pub fn improve(
             trades: &trades,
         };
         // Every move of the round, evaluated; the best few are then polished.
-        let Offered {
-            list: mut offers,
-            mesh_trades,
-        } = offer_all(pool, &round, &mut search, &mut scratch);
-        trade_offers = offers[mesh_trades]
-            .iter()
-            .map(|o| search.trade(o))
-            .collect();
+        let mut offers = offer_all(pool, &round, &mut search, &mut scratch);
         // Polish the moves that made the best pictures (a move that made a poor one
         // seldom becomes the best by a change of depth), then take the best-ranked.
         offers.sort_by(|a, b| search.free(&a.eval).total_cmp(&search.free(&b.eval)));
@@ -423,8 +378,6 @@ pub fn improve(
                     iou_after: e.iou,
                 });
                 *best = e;
-                // Trades of the launch before this move are stale.
-                trade_offers.clear();
             }
             None => break,
         }
@@ -435,10 +388,8 @@ pub fn improve(
     // Leave the workspace holding the kept launch's flight and shadow.
     *best = problem.evaluate_held(held, params, weights, ws);
     let kept = search.free(best);
-    trade_offers.sort_by(|a, b| a.free.total_cmp(&b.free));
     MoveReport {
         samples: search.samples,
-        trades: trade_offers,
         promising: search
             .promising
             .filter(|(energy, _)| *energy < kept)
@@ -612,34 +563,20 @@ impl Scratch {
 }
 
 /// Every move of `round`, evaluated, each beside the others ([`beside`]): their offers
-/// in the registry's order, and where the trades of meshes are among them.
+/// in the registry's order.
 fn offer_all<'a>(
     pool: &rayon::ThreadPool,
     round: &Round,
     search: &mut Search<'a>,
     scratch: &mut [Scratch],
-) -> Offered {
-    let mut all = Offered {
-        list: Vec::new(),
-        mesh_trades: 0..0,
-    };
-    for part in beside(pool, search, MOVES.to_vec(), scratch, |m, out| {
+) -> Vec<Offer> {
+    beside(pool, search, MOVES.to_vec(), scratch, |m, out| {
         out.name = m.name();
         m.offer(round, out)
-    }) {
-        if !part.mesh_trades.is_empty() {
-            let at = all.list.len();
-            all.mesh_trades = at + part.mesh_trades.start..at + part.mesh_trades.end;
-        }
-        all.list.extend(part.list);
-    }
-    all
-}
-
-/// What a part of a round offered ([`Offers`] without its scratch).
-struct Offered {
-    list: Vec<Offer>,
-    mesh_trades: Range<usize>,
+    })
+    .into_iter()
+    .flatten()
+    .collect()
 }
 
 /// Run `work` on each of `items` beside the others on `pool`, each with a search of its
@@ -659,12 +596,12 @@ fn beside<'a, T: Send>(
     items: Vec<T>,
     scratch: &mut [Scratch],
     work: impl Fn(T, &mut Offers<'_, 'a>) + Sync,
-) -> Vec<Offered> {
+) -> Vec<Vec<Offer>> {
     use rayon::prelude::*;
     let queue = std::sync::Mutex::new(items.into_iter().enumerate());
     let next = || queue.lock().unwrap_or_else(|e| e.into_inner()).next();
     let parent = &*search;
-    let mut done: Vec<(usize, Search<'a>, Offered)> = pool.install(|| {
+    let mut done: Vec<(usize, Search<'a>, Vec<Offer>)> = pool.install(|| {
         scratch
             .par_iter_mut()
             .flat_map_iter(|s| {
@@ -674,10 +611,7 @@ fn beside<'a, T: Send>(
                     let mut out =
                         Offers::new(&mut part, &mut s.ws, &mut s.candidate, &mut s.flight);
                     work(item, &mut out);
-                    let Offers {
-                        list, mesh_trades, ..
-                    } = out;
-                    let offered = Offered { list, mesh_trades };
+                    let offered = out.list;
                     mine.push((k, part, offered));
                 }
                 mine

@@ -11,7 +11,7 @@ use super::pose::{fit_and_launch, SEAT_KEPT, SEAT_PAIRS};
 use super::seats::{self, Seats};
 use super::sight::exchangeable;
 use super::spin::{launch_to, spin_guesses};
-use super::{Move, Offers, Round, TRADE_SLACK};
+use super::{Move, Offers, Round};
 use crate::geometry::shape::Shape;
 use crate::scene::Launch;
 
@@ -94,26 +94,20 @@ impl Move for Seat {
         out.name = "trade";
         let shape = |i: usize| &problem.scene.occluders[i].shape;
         for group in r.trades {
-            let of_meshes = matches!(shape(group[0]), Shape::Mesh(_));
-            let (cap, longest, slack) = if of_meshes {
-                (seats::MESH_TRADES, group.len(), TRADE_SLACK)
-            } else {
-                (seats::TRADES, seats::BLOCK_CYCLE, 1)
+            let (cap, longest) = match shape(group[0]) {
+                Shape::Mesh(_) => (seats::MESH_TRADES, group.len()),
+                _ => (seats::TRADES, seats::BLOCK_CYCLE),
             };
-            let first = out.list.len();
             let trades = seats.trade_scan(group, (cap, longest), out.ws);
             let found = seats::each(problem, &trades, out.ws, |trade, ws| {
                 seats.many(trade, SEAT_KEPT, ws)
             });
             for (trade, found) in trades.iter().zip(found) {
-                if let Some((_, poses)) = found.filter(|f| f.0 < slack * r.wrong) {
+                if let Some((_, poses)) = found.filter(|f| f.0 < r.wrong) {
                     let seated: Vec<(usize, (DVec3, DQuat))> =
                         trade.iter().map(|c| c.0).zip(poses).collect();
                     seat(r, &seated, out);
                 }
-            }
-            if of_meshes {
-                out.mesh_trades = first..out.list.len();
             }
         }
         out.ws.poses.copy_from_slice(&r.current_poses);

@@ -420,10 +420,10 @@ pub(super) const SPLITS: usize = 4;
 /// nothing more.
 pub(super) const TRADES: usize = 30;
 
-/// Trades of meshes that [`improve`](super::improve) refines and reports
-/// ([`MoveReport::trades`](super::MoveReport::trades)): the table's ranks say little of
-/// them (a piece's scanned shadow is off by hundreds of pixels), so many of its trades
-/// (six pieces of six shapes make 409 cycles, 15 pairs and 40 three-cycles of them).
+/// Trades of meshes that [`improve`](super::improve) seats and offers: the table's ranks
+/// say little of them (a piece's scanned shadow is off by hundreds of pixels), so many
+/// of its trades (six pieces of six shapes make 409 cycles, 15 pairs and 40 three-cycles
+/// of them).
 pub(super) const MESH_TRADES: usize = 40;
 
 /// The blocks in a trade at most: pairs and cycles of three. A trade of blocks is judged

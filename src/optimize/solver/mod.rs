@@ -408,8 +408,8 @@ fn attempt(
             unplaced[i] = false;
         }
     }
-    // The scene's last stage of one body: the settings of the one-body runs that refine
-    // trades and the last stage's polish.
+    // The scene's last stage of one body: the settings of the one-body runs of the last
+    // stage's polish.
     let one_body = scene.stages.iter().rev().find(|s| s.vary.len() == 1);
     let until = options.until_stage.unwrap_or(usize::MAX);
     for (k, stage) in scene

@@ -1,5 +1,5 @@
-//! The passes that refine candidates by CMA-ES runs of one body at a time: the trades
-//! ([`trade_trials`]) that the moves offer, and the last stage's [`polish`].
+//! The pass that refines by CMA-ES runs of one body at a time: the last stage's
+//! [`polish`].
 
 use super::schedule::POLISH_STEP_SHARE;
 use super::search::{local_run, rank_value, stage_seed, Pool};
@@ -7,49 +7,6 @@ use crate::evaluate::{Evaluation, Held, Problem, Workspace};
 use crate::optimize::moves;
 use crate::output::solution::MoveRecord;
 use crate::scene::Stage;
-
-/// The trades of pieces that no call of the moves took as seated (`trades`, best picture
-/// first), each searched by two rounds of one-piece runs of `template` (a stage of one
-/// body) over its pieces, with `stage`'s weights: the first whose search ranks better
-/// than `kept` (its launch), and the samples drawn. A seated trade in a cluster of
-/// overlapping pieces draws a worse picture than the launch kept until its pieces have
-/// found their poses on their new places, which the seats' scans are too coarse to
-/// judge: on the planted chess 10903 the trade that mends it is the 28th of 40 by its
-/// seated picture.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn trade_trials(
-    problem: &Problem,
-    pool: &Pool,
-    stage: &Stage,
-    template: &Stage,
-    trades: &[moves::Trade],
-    kept: f64,
-    seed: u64,
-    ws: &mut Workspace,
-    record: &mut dyn FnMut(&Evaluation),
-) -> (Option<Vec<f64>>, usize) {
-    let mut samples = 0;
-    for (t, trade) in trades.iter().enumerate() {
-        let mut launch = trade.launch.clone();
-        let mut rank = f64::INFINITY;
-        let rounds = trade.bodies.iter().cycle().take(2 * trade.bodies.len());
-        for (g, &body) in rounds.enumerate() {
-            let run = Stage {
-                vary: vec![body],
-                weights: stage.weights,
-                ..template.clone()
-            };
-            let used;
-            let seed = stage_seed(seed, 1_000_000 + 16 * t + g);
-            (launch, rank, used) = local_run(problem, pool, &run, &launch, seed, ws, record);
-            samples += used;
-        }
-        if rank < kept {
-            return (Some(launch), samples);
-        }
-    }
-    (None, samples)
-}
 
 /// The last stage's polish: first the moves with every block seated anew on its own
 /// place (`moves::improve` for [`moves::Purpose::Polish`]), then each of the stage's bodies in turn,

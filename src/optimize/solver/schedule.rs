@@ -20,8 +20,7 @@ pub enum Pass {
     /// moves.
     Runs,
     /// Trades of places among bodies of one kind and different shapes (moves that
-    /// trade, then the trades searched when none is taken as seated), then runs again
-    /// from the trade taken.
+    /// trade, each judged as seated), then runs again from the trade taken.
     Trades,
     /// Every block seated anew, then each body refined alone by a run with a tenth of
     /// the one-body stage's step.

@@ -9,7 +9,7 @@
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
-use super::refine::{polish, trade_trials};
+use super::refine::polish;
 use super::schedule::{Judge, Pass, Schedule, Step, When, TRADE_MOVES};
 use super::search::{
     best_on_reference, rank_value, restart_seed, run_iterations, run_moved_picture, stage_seed,
@@ -80,7 +80,6 @@ pub(super) struct StageRun<'a> {
     interrupted: bool,
     stop: Option<StopReason>,
     judge: Judge,
-    trade_taken: bool,
     /// The best before the current run's moves: what a restart asks the run to have
     /// improved on.
     run_start: Evaluation,
@@ -146,7 +145,6 @@ impl<'a> StageRun<'a> {
             interrupted: false,
             stop: None,
             judge: Judge::Stage,
-            trade_taken: false,
             run_start: eval,
             moved: None,
             taken: Vec::new(),
@@ -227,13 +225,6 @@ impl<'a> StageRun<'a> {
         self.eval = self
             .problem
             .evaluate_held(&self.held, &self.best, weights, &mut self.ws);
-    }
-
-    /// Take `launch` as the best, judged now.
-    fn take(&mut self, launch: &[f64]) {
-        self.best.copy_from_slice(launch);
-        self.rejudge(&self.weights());
-        self.mask.copy_from(&self.ws.mask);
     }
 
     /// A round of moves from the best (see [`moves::improve`]), at most `max_moves`,
@@ -423,9 +414,8 @@ impl<'a> StageRun<'a> {
     }
 
     /// [`Pass::Trades`]: moves that trade places among bodies (at most
-    /// [`TRADE_MOVES`]); when none is taken as seated, the trades they offer searched by
-    /// one-body runs ([`trade_trials`]); after a trade taken, runs again. A stage where
-    /// no trade draws a better picture ends as its runs did, judged as before.
+    /// [`TRADE_MOVES`]); after a trade taken, runs again. A stage where no trade draws a
+    /// better picture ends as its runs did, judged as before.
     fn trades(&mut self) {
         let run_start = self.eval;
         self.rejudge(&self.weights());
@@ -435,40 +425,12 @@ impl<'a> StageRun<'a> {
             self.run_start = run_start;
             return self.runs();
         }
-        let contacts = self.problem.scene.contacts;
-        let kept = rank_value(&self.eval, contacts);
-        let (k, iteration, stage) = (self.k, self.iteration, self.judged().clone());
-        let records = &mut *self.records;
-        let (better, used) = match self.one_body {
-            Some(template) => trade_trials(
-                self.problem,
-                self.pool,
-                &stage,
-                template,
-                &moved.trades,
-                kept,
-                stage_seed(self.seed, k),
-                &mut self.ws,
-                &mut |e: &Evaluation| records.push(sample_record(k, iteration, &stage.weights, e)),
-            ),
-            None => (None, 0),
-        };
-        self.samples += used;
         self.moved = None;
-        match better {
-            Some(launch) => {
-                self.take(&launch);
-                self.trade_taken = true;
-                self.runs();
-            }
-            None => {
-                // No trade drew a better picture: the stage ends as its last run did,
-                // judged as it ran.
-                self.judge = Judge::Stage;
-                let given = self.given.weights;
-                self.rejudge(&given);
-            }
-        }
+        // No trade drew a better picture: the stage ends as its last run did, judged as
+        // it ran.
+        self.judge = Judge::Stage;
+        let given = self.given.weights;
+        self.rejudge(&given);
     }
 
     /// [`Pass::Polish`]: see [`polish`]; the stage's picture judged afterwards as its
@@ -496,12 +458,7 @@ impl<'a> StageRun<'a> {
         self.samples += used;
         let seated = taken.len();
         self.taken.extend(taken);
-        let ran = if self.trade_taken {
-            self.unhinted.weights
-        } else {
-            self.given.weights
-        };
-        self.rejudge(&ran);
+        self.rejudge(&self.given.weights);
         self.mask.copy_from(&self.ws.mask);
         self.polish = Some(format!(
             "; moves taken: {seated}, polished {moved} of {} bodies, IoU {before:.4} to {:.4}",
