@@ -13,7 +13,7 @@
 //! strategy, then the final joint stage) from the best launch of the previous one,
 //! the others held fixed, through the schedule's passes (`stage`): moves, CMA-ES runs
 //! whose populations are evaluated in parallel on a rayon pool with one [`Workspace`]
-//! per thread (`search`), and the one-body refinements of trades and the polish
+//! per thread (`search`), and the one-body runs of the last stage's polish
 //! (`refine`).
 //!
 //! Determinism: candidates come from one seeded RNG per stage in `ask`, and each

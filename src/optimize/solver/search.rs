@@ -1,7 +1,7 @@
 //! The search's machinery below the schedule's passes: the [`Pool`] that evaluates a
 //! population in parallel, the rank CMA-ES sorts by ([`rank_value`]), the seeds of
 //! stages and runs, and one CMA-ES run of a few bodies ([`local_run`]) that the
-//! trades and polish refine with.
+//! polish refines with.
 
 use std::sync::Mutex;
 

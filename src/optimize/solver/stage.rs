@@ -2,9 +2,10 @@
 //! state ([`StageRun`]), each recorded as a [`PassRecord`].
 //!
 //! Data flow: the stage starts from the previous stage's best launch; [`Pass::Moves`]
-//! jumps, [`Pass::Runs`] runs CMA-ES (IPOP restarts, each after a round of moves), [`Pass::Trades`] and
-//! [`Pass::Polish`] mend what the runs leave in the last stage; the stage never ends
-//! worse than it started (last stage) and reports to the observer.
+//! jumps, [`Pass::Runs`] runs CMA-ES (IPOP restarts, each after a round of moves),
+//! [`Pass::Trades`] and [`Pass::Polish`] mend what the runs leave in the last stage;
+//! the stage never ends worse than it started (last stage) and reports to the
+//! observer.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
