@@ -6,7 +6,8 @@
 //! race ([`race`]) and the best ([`Variant::better_than`]) is kept ([`Found`]). When no
 //! design's solve reaches [`REPLACE_BELOW`], a second round designs again under the
 //! ceilings of the best designs ([`crate::design::ANEW_CEILINGS`]) with the objects
-//! placed anew ([`crate::design::cover::Cover::replace`]) and races those.
+//! placed anew ([`crate::design::cover::Cover::replace`]), each from the first round's
+//! [`crate::design::Draft`] under its ceiling and order, and races those.
 //!
 //! A start guess's IoU says little of where its solve ends: on 27 held-out pictures the
 //! design with the best start was the best solved one for 12. So the designs are
@@ -213,16 +214,13 @@ impl Search<'_> {
     pub fn run(&self, watch: &dyn Watch, interrupts: &AtomicUsize) -> Found {
         let mut settings: Vec<Setting> = round_settings(self.ceilings, false).collect();
         let first_round = settings.len();
-        let mut designed = Vec::new();
-        let mut same_as = Vec::new();
-        self.round(
-            &settings,
-            0..first_round,
-            &mut designed,
-            &mut same_as,
-            watch,
-            interrupts,
-        );
+        let mut made = Made::default();
+        self.round(&settings, 0..first_round, &mut made, watch, interrupts);
+        let Made {
+            mut designed,
+            mut same_as,
+            drafts,
+        } = made;
         let best_trial = designed
             .iter()
             .filter_map(|v| v.as_ref().ok()?.solved)
@@ -241,15 +239,18 @@ impl Search<'_> {
                 }
             }
             settings.extend(round_settings(&anew_under, true));
+            // Only the drafts of the ceilings placed anew are wanted (a few MB each).
+            let mut drafts = drafts;
+            let wanted = |c: u64| anew_under.iter().any(|a| a.to_bits() == c);
+            (drafts.get_mut().unwrap_or_else(|e| e.into_inner())).retain(|((c, _), _)| wanted(*c));
             let ks = first_round..settings.len();
-            self.round(
-                &settings,
-                ks,
-                &mut designed,
-                &mut same_as,
-                watch,
-                interrupts,
-            );
+            let mut made = Made {
+                designed,
+                same_as,
+                drafts,
+            };
+            self.round(&settings, ks, &mut made, watch, interrupts);
+            (designed, same_as) = (made.designed, made.same_as);
         }
         let mut found = Found {
             best: None,
@@ -284,17 +285,18 @@ impl Search<'_> {
     }
 
     /// Design under the settings `ks` (in parallel, each made contact-free), append
-    /// them to `designed`, and to `same_as` the earlier design each repeats (one that
-    /// another order or round made too); with `trial`, race those that repeat none.
-    fn round(
-        &self,
+    /// them to `made.designed`, and to `made.same_as` the earlier design each repeats
+    /// (one that another order or round made too); with `trial`, race those that repeat
+    /// none.
+    fn round<'s>(
+        &'s self,
         settings: &[Setting],
         ks: Range<usize>,
-        designed: &mut Vec<Result<Variant, SearchError>>,
-        same_as: &mut Vec<Option<usize>>,
+        made: &mut Made<'s>,
         watch: &dyn Watch,
         interrupts: &AtomicUsize,
     ) {
+        let drafts = &made.drafts;
         let replace = ks.clone().any(|k| settings[k].replace);
         watch.begin(
             ks.len() as u64,
@@ -322,12 +324,13 @@ impl Search<'_> {
                 })
             })
             .collect();
-        let mut made: Vec<Option<Result<Variant, SearchError>>> = ks
+        let mut now: Vec<Option<Result<Variant, SearchError>>> = ks
             .clone()
             .into_par_iter()
             .map(|k| {
                 twin[k - ks.start].is_none().then(|| {
-                    let variant = unless_interrupted(interrupts, || self.design(settings[k], k));
+                    let variant =
+                        unless_interrupted(interrupts, || self.design(settings[k], k, drafts));
                     watch.step();
                     variant
                 })
@@ -335,20 +338,21 @@ impl Search<'_> {
             .collect();
         for k in ks.clone() {
             if let Some(j) = twin[k - ks.start] {
-                let v = match &made[j - ks.start] {
+                let v = match &now[j - ks.start] {
                     Some(Ok(v)) => Ok(Variant {
                         setting: settings[k],
                         ..v.clone()
                     }),
                     // The twin's error, made again (errors do not clone).
-                    _ => unless_interrupted(interrupts, || self.design(settings[k], k)),
+                    _ => unless_interrupted(interrupts, || self.design(settings[k], k, drafts)),
                 };
-                made[k - ks.start] = Some(v);
+                now[k - ks.start] = Some(v);
                 watch.step();
             }
         }
         watch.end();
-        designed.extend(made.into_iter().map(|v| v.expect("every setting designed")));
+        let (designed, same_as) = (&mut made.designed, &mut made.same_as);
+        designed.extend(now.into_iter().map(|v| v.expect("every setting designed")));
         let scenes: Vec<Option<String>> = designed
             .iter()
             .map(|v| {
@@ -399,19 +403,39 @@ impl Search<'_> {
     }
 
     /// Design under `setting` (the `k`-th), make its start guess contact-free and
-    /// evaluate it.
-    fn design(&self, setting: Setting, k: usize) -> Result<Variant, SearchError> {
-        let geometry = Geometry {
-            ceiling: setting.ceiling,
-            ..self.geometry.clone()
+    /// evaluate it. A first round's draft is kept in `drafts` when a second round may
+    /// place its objects anew; that round's design starts from it (the same bits as
+    /// making it again).
+    fn design<'s>(
+        &'s self,
+        setting: Setting,
+        k: usize,
+        drafts: &Drafts<'s>,
+    ) -> Result<Variant, SearchError> {
+        let key = (setting.ceiling.to_bits(), setting.order);
+        let list = || drafts.lock().unwrap_or_else(|e| e.into_inner());
+        let kept = match setting.replace {
+            true => {
+                let mut list = list();
+                let i = list.iter().position(|(k, _)| *k == key);
+                i.map(|i| list.swap_remove(i).1)
+            }
+            false => None,
         };
-        let mut plan = design::design(
-            self.picture,
-            geometry,
-            self.request,
-            setting.order,
-            setting.replace,
-        )?;
+        let draft = match kept {
+            Some(d) => d,
+            None => {
+                let geometry = Geometry {
+                    ceiling: setting.ceiling,
+                    ..self.geometry.clone()
+                };
+                design::draft(self.picture, geometry, self.request, setting.order)?
+            }
+        };
+        if !setting.replace && self.trial && self.rounds >= 2 {
+            list().push((key, draft.clone()));
+        }
+        let mut plan = draft.finish(setting.replace);
         let mut problem = self.problem(&plan, k)?;
         let n = plan.objects.len();
         let sep = separate::separate(&mut plan, &mut problem, 4 * n + 10);
@@ -427,6 +451,19 @@ impl Search<'_> {
             solved: None,
         })
     }
+}
+
+/// The first round's drafts, by ceiling (its bits) and order, for the second
+/// ([`Search::design`]).
+type Drafts<'a> = std::sync::Mutex<Vec<((u64, Order), design::Draft<'a>)>>;
+
+/// The designs of a search so far ([`Search::round`]): each setting's, the earlier
+/// setting each repeats, and the first round's drafts.
+#[derive(Default)]
+struct Made<'a> {
+    designed: Vec<Result<Variant, SearchError>>,
+    same_as: Vec<Option<usize>>,
+    drafts: Drafts<'a>,
 }
 
 /// `work()`, unless the interrupt counter was raised: after it nothing is written, so

@@ -279,8 +279,9 @@ pub fn check_dark_part(
 
 /// Design a scene: place every object's shadow on `picture` (in `order`), add objects
 /// of the `auto:` kind while they gain enough, exchange objects of different shapes
-/// (not two balls made to measure) where both fit better, with `replace` place each
-/// object anew where it gains more ([`Cover::replace`]), polish, and plan the launches.
+/// (not two balls made to measure) where both fit better ([`draft`]); then with
+/// `replace` place each object anew where it gains more, polish, and plan the launches
+/// ([`Draft::finish`]).
 pub fn design(
     picture: &Picture,
     geometry: Geometry,
@@ -288,6 +289,31 @@ pub fn design(
     order: Order,
     replace: bool,
 ) -> Result<Plan, DesignError> {
+    Ok(draft(picture, geometry, request, order)?.finish(replace))
+}
+
+/// A design before its objects are placed anew and polished: what [`design`] makes of
+/// a ceiling and an order whether or not it then places anew, so that `bsa new`'s
+/// second round (the same ceilings and orders, placed anew) starts from its first
+/// round's drafts instead of making them again.
+#[derive(Clone)]
+pub struct Draft<'a> {
+    cover: Cover<'a>,
+    geometry: Geometry,
+    objects: Vec<Object>,
+    /// The pose families of every placement's object.
+    families: Vec<Vec<pose::Family>>,
+    stop: Option<AutoStop>,
+}
+
+/// The first part of [`design`]: every object placed in `order`, the `auto:` kinds
+/// added, objects exchanged.
+pub fn draft<'a>(
+    picture: &'a Picture,
+    geometry: Geometry,
+    request: &Request,
+    order: Order,
+) -> Result<Draft<'a>, DesignError> {
     let frame = geometry.frame();
     let mut cover = Cover::new(picture, frame);
     let mut objects = request.fixed.clone();
@@ -316,7 +342,7 @@ pub fn design(
         return Err(DesignError::NothingWorthIt);
     }
     // Which object goes where, reconsidered (see `Cover::exchange`).
-    let fams: Vec<Vec<pose::Family>> = cover
+    let families: Vec<Vec<pose::Family>> = cover
         .placements
         .iter()
         .map(|p| objects[p.object].families())
@@ -333,17 +359,31 @@ pub fn design(
         .collect();
     let same = |a: usize, b: usize| shapes[a] == shapes[b] || measured[a] && measured[b];
     for _ in 0..EXCHANGE_ROUNDS {
-        if cover.exchange(&fams, &same) == 0 {
+        if cover.exchange(&families, &same) == 0 {
             break;
         }
     }
-    if replace {
-        cover.replace(&fams);
+    Ok(Draft {
+        cover,
+        geometry,
+        objects,
+        families,
+        stop,
+    })
+}
+
+impl Draft<'_> {
+    /// The rest of [`design`]: with `replace` each object placed anew where it gains
+    /// more ([`Cover::replace`]), then the polish and the launches' plan.
+    pub fn finish(mut self, replace: bool) -> Plan {
+        if replace {
+            self.cover.replace(&self.families);
+        }
+        self.cover.polish(POLISH_ROUNDS);
+        let mut plan = Plan::new(self.geometry, self.objects, self.cover.placements);
+        plan.auto_stop = self.stop;
+        plan
     }
-    cover.polish(POLISH_ROUNDS);
-    let mut plan = Plan::new(geometry, objects, cover.placements);
-    plan.auto_stop = stop;
-    Ok(plan)
 }
 
 /// Why an automatic count stopped where it did.

@@ -118,6 +118,7 @@ fn from_pixel(c: DVec2, (s, co): (f64, f64), scale: f64, p: DVec2) -> DVec2 {
 }
 
 /// The state of the cover: what each pixel is worth and who is on it.
+#[derive(Clone)]
 pub struct Cover<'a> {
     picture: &'a Picture,
     frame: Frame,
