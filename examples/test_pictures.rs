@@ -10,10 +10,10 @@
 //! extra `bsa new` options; its `"about"` says when the set was drawn and how its
 //! objects were stated. `scripts/new-suite.sh` reads the same manifests.
 //!
-//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET 1 to 21 or
-//! `all`, default `all`; DIR default `tools/test-pictures/set-NN`, only with one SET):
-//! reads the set's manifest and writes `DIR/<name>.png`. The output depends only on the
-//! font file, the manifests and this code.
+//! Run: `cargo run --release --example test_pictures [-- SET [DIR]]` (SET the number
+//! of a folder `tools/test-pictures/set-NN`, or `all`, default `all`; DIR default that
+//! folder, only with one SET): reads the set's manifest and writes `DIR/<name>.png`.
+//! The output depends only on the font file, the manifests and this code.
 
 use std::error::Error;
 use std::path::{Path, PathBuf};

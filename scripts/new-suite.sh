@@ -6,7 +6,7 @@
 # whole processes). The overlays are tiled into docs/images/new-suite[-auto].png.
 #
 #     bash scripts/new-suite.sh [SEED] [auto]      # defaults: seed 1, the stated boxes
-#     SET=2 bash scripts/new-suite.sh 1             # set 2 (tools/test-pictures/set-02), or 3 to 21
+#     SET=2 bash scripts/new-suite.sh 1             # set 2 (tools/test-pictures/set-02), or any other set-NN
 #
 # With `auto`, every picture gets one automatic item of its kind instead (auto:box of the
 # unit block for the block pictures, auto:sphere for the sphere one, auto:chess for the
