@@ -216,22 +216,18 @@ impl Search<'_> {
         let first_round = settings.len();
         let mut made = Made::default();
         self.round(&settings, 0..first_round, &mut made, watch, interrupts);
-        let Made {
-            mut designed,
-            mut same_as,
-            drafts,
-        } = made;
-        let best_trial = designed
+        let best_trial = made
+            .designed
             .iter()
             .filter_map(|v| v.as_ref().ok()?.solved)
             .filter(|s| s.clear && s.finished())
             .map(|s| s.iou)
             .fold(f64::NEG_INFINITY, f64::max);
-        let second = self.rounds >= 2 && self.trial && best_trial < REPLACE_BELOW;
+        let second = self.may_place_anew() && best_trial < REPLACE_BELOW;
         let mut anew_under: Vec<f64> = Vec::new();
         if second && interrupts.load(Ordering::SeqCst) == 0 {
             // The ceilings of the best designs, best first.
-            let mut ranked: Vec<&Variant> = designed.iter().flatten().collect();
+            let mut ranked: Vec<&Variant> = made.designed.iter().flatten().collect();
             ranked.sort_by(|a, b| b.rank().partial_cmp(&a.rank()).expect("IoUs are numbers"));
             for v in ranked {
                 if anew_under.len() < ANEW_CEILINGS && !anew_under.contains(&v.setting.ceiling) {
@@ -240,17 +236,11 @@ impl Search<'_> {
             }
             settings.extend(round_settings(&anew_under, true));
             // Only the drafts of the ceilings placed anew are wanted (a few MB each).
-            let mut drafts = drafts;
             let wanted = |c: u64| anew_under.iter().any(|a| a.to_bits() == c);
-            (drafts.get_mut().unwrap_or_else(|e| e.into_inner())).retain(|((c, _), _)| wanted(*c));
+            let drafts = made.drafts.get_mut().unwrap_or_else(|e| e.into_inner());
+            drafts.retain(|((c, _), _)| wanted(*c));
             let ks = first_round..settings.len();
-            let mut made = Made {
-                designed,
-                same_as,
-                drafts,
-            };
             self.round(&settings, ks, &mut made, watch, interrupts);
-            (designed, same_as) = (made.designed, made.same_as);
         }
         let mut found = Found {
             best: None,
@@ -260,7 +250,7 @@ impl Search<'_> {
             ceilings: self.ceilings.to_vec(),
             anew_under,
         };
-        for (v, same) in designed.into_iter().zip(same_as) {
+        for (v, same) in made.designed.into_iter().zip(made.same_as) {
             match v {
                 Ok(v) => {
                     found.trials.push(match same {
@@ -392,6 +382,11 @@ impl Search<'_> {
         }
     }
 
+    /// Whether a second round may place the objects anew ([`Search::run`]).
+    fn may_place_anew(&self) -> bool {
+        self.rounds >= 2 && self.trial
+    }
+
     /// The scene file's JSON of `plan`.
     fn scene_json(&self, plan: &Plan) -> Value {
         plan.scene_json(self.name, self.target, self.seed)
@@ -432,7 +427,7 @@ impl Search<'_> {
                 design::draft(self.picture, geometry, self.request, setting.order)?
             }
         };
-        if !setting.replace && self.trial && self.rounds >= 2 {
+        if !setting.replace && self.may_place_anew() {
             list().push((key, draft.clone()));
         }
         let mut plan = draft.finish(setting.replace);
